@@ -1,0 +1,110 @@
+"""The ``rosl`` root command: a static, lazy map of command groups and the error boundary.
+
+Subcommand modules are imported only when used, so ``rosl --help`` and ``rosl topic list``
+never load numpy, pymunk or mcap. Errors: a ``RoslError`` prints one line on stderr and exits
+1; click usage errors keep exit 2; Ctrl-C exits 130 quietly; anything else is a bug and keeps
+its traceback.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+from typing import Any
+
+import click
+
+from rosl.errors import RoslError
+
+# name -> (module, one-line help); the module defines a click command named ``command``
+COMMANDS: dict[str, tuple[str, str]] = {
+    "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),
+    "pkg": ("rosl.cli.pkg", "Various package related sub-commands"),
+}
+CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+class LazyGroup(click.Group):
+    """A group whose subcommands are imported on first use."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        """List the command names."""
+        return sorted(COMMANDS)
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        """Import and return one command."""
+        if cmd_name not in COMMANDS:
+            return None
+        module = importlib.import_module(COMMANDS[cmd_name][0])
+        command: click.Command = module.command
+        return command
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """Write the command list without importing any command."""
+        rows = [(name, COMMANDS[name][1]) for name in self.list_commands(ctx)]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+    def resolve_command(
+        self, ctx: click.Context, args: list[str]
+    ) -> tuple[str | None, click.Command | None, list[str]]:
+        """Resolve a command name, suggesting close names for typos."""
+        name = args[0] if args else ""
+        if name and not name.startswith("-") and name not in COMMANDS:
+            from rosl.idl.names import did_you_mean
+
+            ctx.fail(f"unknown command '{name}'{did_you_mean(name, COMMANDS)}")
+        return super().resolve_command(ctx, args)
+
+
+@click.group(cls=LazyGroup, context_settings=CONTEXT)
+@click.version_option(package_name="rosl", prog_name="rosl")
+def cli() -> None:
+    """rosl: ROS 2's everyday workflow in pure Python: no ROS install, no build step."""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line and return (or exit with) its status."""
+    try:
+        result: Any = cli.main(args=argv, prog_name="rosl", standalone_mode=False)
+    except click.exceptions.Exit as done:
+        return _exit(done.exit_code)
+    except click.ClickException as err:
+        err.show()
+        return _exit(err.exit_code)
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        return _exit(130)
+    except RoslError as err:
+        _flush_quietly()
+        print(str(err).splitlines()[0] if str(err) else type(err).__name__, file=sys.stderr)
+        return _exit(err.exit_code)
+    except BrokenPipeError:
+        _silence_stdout()
+        return _exit(1)
+    code = result if isinstance(result, int) else 0
+    _flush_quietly()
+    return _exit(code)
+
+
+def _flush_quietly() -> None:
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+
+
+def _silence_stdout() -> None:
+    # stdout's reader went away (`rosl ... | head`): send the rest to /dev/null quietly
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+
+
+def _exit(code: int) -> int:
+    if __name__ == "__main__" or (sys.argv and sys.argv[0].endswith("rosl")):
+        sys.exit(code)
+    return code
+
+
+if __name__ == "__main__":
+    main()

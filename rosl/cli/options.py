@@ -1,0 +1,38 @@
+"""Option helpers shared by commands."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import click
+
+
+class GreedyOption(click.Option):
+    """An option taking every following value up to the next option, like argparse's ``nargs='+'``.
+
+    ``--dependencies rclpy std_msgs geometry_msgs`` gives all three, as ``ros2`` accepts.
+    """
+
+    def add_to_parser(self, parser: Any, ctx: click.Context) -> None:
+        """Register the option, then make its parser consume the values that follow it."""
+        super().add_to_parser(parser, ctx)
+        for name in self.opts:
+            option = parser._long_opt.get(name) or parser._short_opt.get(name)
+            if option is None:
+                continue
+            original = option.process
+
+            def process(value: Any, state: Any, _original: Any = original) -> None:
+                values = [value]
+                while state.rargs and not state.rargs[0].startswith("-"):
+                    values.append(state.rargs.pop(0))
+                _original(tuple(values), state)
+
+            option.process = process
+
+    def type_cast_value(self, ctx: click.Context, value: Any) -> Any:
+        """Flatten the tuples gathered for each occurrence."""
+        flat: list[str] = []
+        for item in value or ():
+            flat.extend(item if isinstance(item, tuple) else (item,))
+        return tuple(flat)

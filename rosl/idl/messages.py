@@ -1,0 +1,436 @@
+"""Message classes generated from parsed specs: construction, ``==``, ``repr``, dicts.
+
+A generated class has ``__slots__`` and a compiled ``__init__`` taking every field by keyword
+or in field order (rosbags' deserializer calls ``cls(*values)``), so building a received
+message costs one Python call. Numeric arrays are numpy arrays of the field's dtype; they are
+properties that accept lists, tuples, ``bytes`` (for 8-bit types) and numpy arrays, and check
+fixed lengths and bounds on assignment. Scalars are plain attributes: a wrong value is found
+when the message is serialized (``store``), where ``check_fields`` names the field.
+"""
+
+from __future__ import annotations
+
+import keyword
+import operator
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from rosl.idl.errors import FieldError
+from rosl.idl.names import did_you_mean, parse_type_name
+from rosl.idl.parser import FLOATS, INTEGER_RANGES, ArrayKind, FieldType
+
+if TYPE_CHECKING:
+    from rosl.idl.parser import MessageSpec
+
+DTYPES: dict[str, Any] = {
+    "bool": np.bool_,
+    "byte": np.int8,
+    "char": np.uint8,
+    "int8": np.int8,
+    "uint8": np.uint8,
+    "int16": np.int16,
+    "uint16": np.uint16,
+    "int32": np.int32,
+    "uint32": np.uint32,
+    "int64": np.int64,
+    "uint64": np.uint64,
+    "float32": np.float32,
+    "float64": np.float64,
+}
+_ZERO: dict[str, Any] = {"bool": False, "string": "", **dict.fromkeys(FLOATS, 0.0)}
+DUMMY_FIELD = "structure_needs_at_least_one_member"
+
+
+class Message:
+    """Base of every generated message class."""
+
+    __slots__ = ()
+    __msgtype__: ClassVar[str]
+    _fields: ClassVar[tuple[str, ...]]
+    _field_types: ClassVar[tuple[FieldType, ...]]
+    _field_classes: ClassVar[dict[str, type[Message]]]
+    _python_name: ClassVar[str]
+    _spec: ClassVar[MessageSpec]
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:  # replaced in every subclass
+        raise TypeError("Message is abstract")
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(_equal(getattr(self, n), getattr(other, n)) for n in self._fields)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        parts = []
+        for name, ftype in zip(self._fields, self._field_types, strict=True):
+            value = getattr(self, name)
+            if isinstance(value, np.ndarray) and ftype.array is not ArrayKind.FIXED:
+                text = repr(value.tolist())
+            else:
+                text = repr(value)
+            parts.append(f"{name}={text}")
+        return f"{self._python_name}({', '.join(parts)})"
+
+    @classmethod
+    def get_fields_and_field_types(cls) -> dict[str, str]:
+        """Return field names and their ROS type spellings, as rclpy does."""
+        return {n: str(t) for n, t in zip(cls._fields, cls._field_types, strict=True)}
+
+
+class ServiceType:
+    """Base of generated service classes: ``Request`` and ``Response`` message classes."""
+
+    __srvtype__: ClassVar[str]
+    Request: ClassVar[type[Message]]
+    Response: ClassVar[type[Message]]
+
+
+def _equal(a: Any, b: Any) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
+    return bool(a == b)
+
+
+def _scalar_default(ftype: FieldType, default: Any) -> Any:
+    if default is not None:
+        return default
+    return _ZERO.get(ftype.base, 0)
+
+
+def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
+    """Return a function turning user values into a numpy array for a numeric array field."""
+    dtype = np.dtype(DTYPES[ftype.base])
+    kinds = "b" if ftype.base == "bool" else "iu" if ftype.base in INTEGER_RANGES else "biuf"
+    low, high = INTEGER_RANGES.get(ftype.base, (0, 0))
+    eight_bit = ftype.base in ("uint8", "byte", "char")
+
+    def coerce(value: Any) -> Any:
+        if value is None:
+            return np.zeros(ftype.size if ftype.array is ArrayKind.FIXED else 0, dtype)
+        if type(value) is np.ndarray and value.dtype == dtype and value.ndim == 1:
+            array = value
+        elif eight_bit and isinstance(value, (bytes, bytearray, memoryview)):
+            array = np.frombuffer(bytes(value), dtype=dtype).copy()
+        else:
+            raw = np.asarray(value)
+            if raw.size == 0:
+                array = np.zeros(0, dtype)
+            elif raw.ndim != 1 or raw.dtype.kind not in kinds:
+                raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
+            else:
+                if kinds == "iu" and (int(raw.min()) < low or int(raw.max()) > high):
+                    raise FieldError(
+                        f"{where}: values must lie in {low} to {high} for {ftype.base}"
+                    )
+                array = raw.astype(dtype)
+        if ftype.array is ArrayKind.FIXED and len(array) != ftype.size:
+            raise FieldError(f"{where}: needs exactly {ftype.size} values, got {len(array)}")
+        if ftype.array is ArrayKind.BOUNDED and len(array) > ftype.size:
+            raise FieldError(f"{where}: holds at most {ftype.size} values, got {len(array)}")
+        return array
+
+    return coerce
+
+
+def _show(value: Any) -> str:
+    text = repr(value)
+    return f"{type(value).__name__} {text[:40] + '...' if len(text) > 40 else text}"
+
+
+def build_message_class(
+    spec: MessageSpec, field_classes: dict[str, type[Message]]
+) -> type[Message]:
+    """Generate the class for a parsed, resolved message.
+
+    Args:
+        spec: the message, with every type reference resolved to ``pkg/msg/Name``.
+        field_classes: the classes of the message types its fields refer to.
+
+    Returns:
+        The new class, a subclass of :class:`Message`.
+    """
+    name = parse_type_name(spec.type_name)
+    namespace: dict[str, Any] = {"_unknown_fields": _unknown_fields}
+    body: dict[str, Any] = {}
+    slots: list[str] = []
+    params: list[str] = []
+    lines: list[str] = []
+    for index, field in enumerate(spec.fields):
+        ftype = field.type
+        where = f"{spec.type_name} field '{field.name}'"
+        attr = _attr_name(field.name)
+        if ftype.is_primitive and ftype.base != "string" and ftype.is_array:
+            coerce = array_coercer(ftype, where)
+            default = None if field.default is None else list(field.default)
+            namespace[f"_d{index}"] = default
+            slots.append("_" + attr)
+            body[attr] = _array_property("_" + attr, coerce)
+            params.append(f"{attr}=None")
+            lines.append(f"    self.{attr} = _d{index} if {attr} is None else {attr}")
+            continue
+        slots.append(attr)
+        if ftype.is_primitive and not ftype.is_array:
+            namespace[f"_d{index}"] = _scalar_default(ftype, field.default)
+            params.append(f"{attr}=_d{index}")
+            lines.append(f"    self.{attr} = {attr}")
+        elif ftype.is_primitive:  # string arrays
+            default = list(field.default or [""] * ftype.size)
+            namespace[f"_d{index}"] = default
+            params.append(f"{attr}=None")
+            lines.append(f"    self.{attr} = list(_d{index}) if {attr} is None else {attr}")
+        else:
+            namespace[f"_c{index}"] = field_classes[ftype.base]
+            params.append(f"{attr}=None")
+            if not ftype.is_array:
+                lines.append(f"    self.{attr} = _c{index}() if {attr} is None else {attr}")
+            elif ftype.array is ArrayKind.FIXED:
+                lines.append(
+                    f"    self.{attr} = [_c{index}() for _ in range({ftype.size})] "
+                    f"if {attr} is None else {attr}"
+                )
+            else:
+                lines.append(f"    self.{attr} = [] if {attr} is None else {attr}")
+    if not spec.fields:
+        params.append("_dummy=0")
+        body[DUMMY_FIELD] = 0
+    source = (
+        f"def __init__(self, {', '.join([*params, '**_unknown'])}):\n"
+        "    if _unknown:\n        _unknown_fields(self, _unknown)\n"
+        + ("\n".join(lines) or "    pass")
+        + "\n"
+    )
+    exec(compile(source, f"<rosl message {spec.type_name}>", "exec"), namespace)
+    body.update(
+        __slots__=tuple(slots),
+        __init__=namespace["__init__"],
+        __msgtype__=spec.type_name,
+        __module__=f"{name.package}.{name.kind}",
+        __qualname__=name.name,
+        __doc__=f"The ROS message type {spec.type_name}.",
+        _fields=tuple(_attr_name(f.name) for f in spec.fields),
+        _field_types=tuple(f.type for f in spec.fields),
+        _field_classes={
+            _attr_name(f.name): field_classes[f.type.base]
+            for f in spec.fields
+            if not f.type.is_primitive
+        },
+        _python_name=name.python_name,
+        _spec=spec,
+    )
+    for constant in spec.constants:
+        body[constant.name] = constant.value
+    for field in spec.fields:
+        if field.default is not None:
+            body[f"{field.name.upper()}__DEFAULT"] = field.default
+    return type(name.name, (Message,), body)
+
+
+def _attr_name(field_name: str) -> str:
+    return f"{field_name}_" if keyword.iskeyword(field_name) else field_name
+
+
+def _array_property(slot: str, coerce: Callable[[Any], Any]) -> property:
+    def setter(self: Message, value: Any) -> None:
+        object.__setattr__(self, slot, coerce(value))
+
+    return property(operator.attrgetter(slot), setter)
+
+
+def _unknown_fields(message: Message, unknown: Mapping[str, Any]) -> None:
+    bad = sorted(unknown)[0]
+    raise FieldError(
+        f"{message.__msgtype__} has no field '{bad}'{did_you_mean(bad, message._fields)}; "
+        f"its fields are: {', '.join(message._fields) or '(none)'}"
+    )
+
+
+def build_service_class(
+    type_name: str, request: type[Message], response: type[Message]
+) -> type[ServiceType]:
+    """Generate the class for a service, holding its ``Request`` and ``Response`` classes."""
+    name = parse_type_name(type_name, "srv")
+    return type(
+        name.name,
+        (ServiceType,),
+        {
+            "__srvtype__": type_name,
+            "__module__": f"{name.package}.{name.kind}",
+            "__qualname__": name.name,
+            "__doc__": f"The ROS service type {type_name}.",
+            "Request": request,
+            "Response": response,
+        },
+    )
+
+
+# --- plain data -------------------------------------------------------------------------------
+
+
+def to_dict(message: Message) -> dict[str, Any]:
+    """Return the message as nested plain dicts, lists and scalars (field order kept)."""
+    return {name: to_plain(getattr(message, name)) for name in message._fields}
+
+
+def to_plain(value: Any) -> Any:
+    """Convert one field value to plain Python data."""
+    if isinstance(value, Message):
+        return to_dict(value)
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, list):
+        return [to_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def from_dict(cls: type[Message], data: Mapping[str, Any] | None) -> Message:
+    """Build a message from plain data; missing fields keep their defaults.
+
+    Raises:
+        FieldError: a key that is not a field, or a value the field cannot hold; the message
+            names the field path (``linear.x``) and the expected type.
+    """
+    message = cls()
+    fill(message, data or {})
+    return message
+
+
+def fill(message: Message, data: Mapping[str, Any], path: str = "") -> None:
+    """Set the fields named in ``data`` on ``message`` (recursively for nested messages)."""
+    if not isinstance(data, Mapping):
+        raise FieldError(
+            f"{path or message.__msgtype__}: expects a mapping of fields "
+            f"({{field: value}}), got {_show(data)}"
+        )
+    types = dict(zip(message._fields, message._field_types, strict=True))
+    for key, value in data.items():
+        key = str(key)
+        where = f"{path}.{key}" if path else key
+        attr = _attr_name(key)
+        if attr not in types:
+            raise FieldError(
+                f"{message.__msgtype__} has no field '{key}'"
+                f"{did_you_mean(key, message._fields)}; its fields are: "
+                f"{', '.join(message._fields) or '(none)'}"
+            )
+        ftype = types[attr]
+        setattr(message, attr, _convert(message, attr, ftype, value, where))
+
+
+def _convert(message: Message, attr: str, ftype: FieldType, value: Any, where: str) -> Any:
+    if not ftype.is_primitive:
+        cls = message._field_classes[attr]
+        if not ftype.is_array:
+            nested = getattr(message, attr)
+            if isinstance(value, Message):
+                return value
+            fill(nested, value, where)
+            return nested
+        if not isinstance(value, list):
+            raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
+        items = []
+        for i, item in enumerate(value):
+            element = cls()
+            fill(element, item, f"{where}[{i}]")
+            items.append(element)
+        _check_length(ftype, len(items), where)
+        return items
+    if ftype.is_array and ftype.base != "string":
+        try:
+            return array_coercer(ftype, where)(value)
+        except FieldError:
+            raise
+        except (TypeError, ValueError) as err:
+            raise FieldError(f"{where}: expects a list of {ftype.base} ({err})") from None
+    if ftype.is_array:
+        if not isinstance(value, list):
+            raise FieldError(f"{where}: expects a list of strings, got {_show(value)}")
+        _check_length(ftype, len(value), where)
+        return [convert_scalar(ftype.element(), v, f"{where}[{i}]") for i, v in enumerate(value)]
+    return convert_scalar(ftype, value, where)
+
+
+def _check_length(ftype: FieldType, length: int, where: str) -> None:
+    if ftype.array is ArrayKind.FIXED and length != ftype.size:
+        raise FieldError(f"{where}: needs exactly {ftype.size} values, got {length}")
+    if ftype.array is ArrayKind.BOUNDED and length > ftype.size:
+        raise FieldError(f"{where}: holds at most {ftype.size} values, got {length}")
+
+
+def convert_scalar(ftype: FieldType, value: Any, where: str) -> Any:
+    """Convert a plain value for a primitive scalar field, or raise a FieldError naming it."""
+    base = ftype.base
+    if base == "string":
+        if isinstance(value, (dict, list)):
+            raise FieldError(f"{where}: expects a string, got {_show(value)}")
+        text = "" if value is None else str(value)
+        if ftype.string_bound and len(text) > ftype.string_bound:
+            raise FieldError(f"{where}: string longer than its bound {ftype.string_bound}")
+        return text
+    if base == "bool":
+        if isinstance(value, bool) or (isinstance(value, int) and value in (0, 1)):
+            return bool(value)
+        raise FieldError(f"{where}: expects a bool (true/false), got {_show(value)}")
+    if base in FLOATS:
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+            raise FieldError(f"{where}: expects a {base} number, got {_show(value)}")
+        return float(value)
+    # integers
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise FieldError(f"{where}: expects a whole number ({base}), got {_show(value)}")
+    low, high = INTEGER_RANGES[base]
+    if base == "byte":  # rosbags stores byte as a signed 8-bit value
+        low, high = -128, 255
+    if not low <= int(value) <= high:
+        raise FieldError(f"{where}: {value} is out of range for {base} ({low} to {high})")
+    return int(value) - 256 if base == "byte" and value > 127 else int(value)
+
+
+def check_fields(message: Message, path: str = "") -> None:
+    """Check every field value of ``message`` against its type.
+
+    Raises:
+        FieldError: the first wrong value, naming its path and the expected type.
+    """
+    for attr, ftype in zip(message._fields, message._field_types, strict=True):
+        where = f"{path}.{attr}" if path else f"{message.__msgtype__}.{attr}"
+        value = getattr(message, attr)
+        if not ftype.is_primitive:
+            cls = message._field_classes[attr]
+            values = value if ftype.is_array else [value]
+            if ftype.is_array:
+                if not isinstance(value, (list, tuple)):
+                    raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
+                _check_length(ftype, len(value), where)
+            for i, item in enumerate(values):
+                item_where = f"{where}[{i}]" if ftype.is_array else where
+                if not isinstance(item, Message) or item._fields != cls._fields:
+                    raise FieldError(f"{item_where}: expects a {ftype.base}, got {_show(item)}")
+                check_fields(item, item_where)
+        elif ftype.is_array and ftype.base == "string":
+            if not isinstance(value, (list, tuple)):
+                raise FieldError(f"{where}: expects a list of strings, got {_show(value)}")
+            _check_length(ftype, len(value), where)
+            for i, item in enumerate(value):
+                _check_scalar(ftype.element(), item, f"{where}[{i}]")
+        elif not ftype.is_array:
+            _check_scalar(ftype, value, where)
+
+
+def _check_scalar(ftype: FieldType, value: Any, where: str) -> None:
+    if ftype.base == "string":
+        if not isinstance(value, str):
+            raise FieldError(f"{where}: expects a string, got {_show(value)}")
+        if ftype.string_bound and len(value) > ftype.string_bound:
+            raise FieldError(f"{where}: string longer than its bound {ftype.string_bound}")
+        return
+    if ftype.base in FLOATS and isinstance(value, str):
+        raise FieldError(f"{where}: expects a {ftype.base} number, got {_show(value)}")
+    convert_scalar(ftype, value, where)

@@ -1,0 +1,110 @@
+"""CDR, message definitions and type hashes — the only module that uses rosbags' type system.
+
+rosbags generates fast CDR (de)serializers per type; we register our parsed types and install
+our own message classes before any serializer is generated, so decoding builds our classes
+directly. Every rosbags error is turned into an ``InterfaceError`` naming the type or field.
+"""
+
+from __future__ import annotations
+
+import struct
+import threading
+from typing import TYPE_CHECKING, Any
+
+from rosbags.interfaces import Nodetype
+from rosbags.serde import SerdeError
+from rosbags.typesys.store import Typestore
+
+from rosl.idl.errors import FieldError, InterfaceError
+from rosl.idl.messages import DUMMY_FIELD, check_fields
+from rosl.idl.parser import ArrayKind, FieldType
+
+if TYPE_CHECKING:
+    from rosl.idl.messages import Message
+    from rosl.idl.parser import MessageSpec
+
+_SERIALIZE_ERRORS = (
+    struct.error,
+    TypeError,
+    AttributeError,
+    ValueError,
+    OverflowError,
+    UnicodeError,
+    SerdeError,
+)
+
+
+def field_desc(ftype: FieldType) -> Any:
+    """Return rosbags' field descriptor for one of our field types."""
+    if ftype.is_primitive:
+        inner: Any = (Nodetype.BASE, (ftype.base, ftype.string_bound))
+    else:
+        inner = (Nodetype.NAME, ftype.base)
+    if ftype.array is ArrayKind.NONE:
+        return inner
+    if ftype.array is ArrayKind.FIXED:
+        return (Nodetype.ARRAY, (inner, ftype.size))
+    return (Nodetype.SEQUENCE, (inner, ftype.size))
+
+
+def typesdict_entry(spec: MessageSpec) -> tuple[list[Any], list[Any]]:
+    """Return the rosbags typesdict entry (constants, fields) for a resolved message."""
+    constants = [(c.name, c.type, c.value) for c in spec.constants]
+    fields = [(f.name, field_desc(f.type)) for f in spec.fields]
+    if not fields:
+        fields = [(DUMMY_FIELD, (Nodetype.BASE, ("uint8", 0)))]
+    return constants, fields
+
+
+class Store:
+    """The process-wide registry of CDR serializers for the types in use."""
+
+    def __init__(self) -> None:
+        self._typestore = Typestore()
+        self._lock = threading.Lock()
+        self._checked: set[str] = set()
+
+    def __contains__(self, type_name: str) -> bool:
+        return type_name in self._typestore.fielddefs
+
+    def add(self, spec: MessageSpec, cls: type[Message]) -> None:
+        """Register a resolved message type and its class (its field types must be added)."""
+        with self._lock:
+            self._typestore.fielddefs[spec.type_name] = typesdict_entry(spec)  # type: ignore[assignment]
+            self._typestore.types[spec.type_name] = cls  # type: ignore[assignment]
+            if any(f.type.string_bound or f.type.array is ArrayKind.BOUNDED for f in spec.fields):
+                self._checked.add(spec.type_name)
+
+    def serialize(self, message: Message) -> bytes:
+        """Serialize a message to CDR (little endian, with the 4-byte encapsulation header).
+
+        Raises:
+            FieldError: a field holds a value its type cannot carry; the error names it.
+        """
+        type_name = message.__msgtype__
+        if type_name in self._checked:
+            check_fields(message)
+        try:
+            return bytes(self._typestore.serialize_cdr(message, type_name, little_endian=True))
+        except _SERIALIZE_ERRORS as err:
+            check_fields(message)
+            raise FieldError(f"cannot serialize {type_name}: {err}") from err
+
+    def deserialize(self, data: bytes | bytearray | memoryview, type_name: str) -> Message:
+        """Decode CDR bytes into a message of ``type_name``.
+
+        Raises:
+            InterfaceError: the bytes are not a valid ``type_name``.
+        """
+        try:
+            return self._typestore.deserialize_cdr(data, type_name)  # type: ignore[return-value]
+        except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
+            raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
+
+    def type_hash(self, type_name: str) -> str:
+        """Return the RIHS01 hash ROS 2 (Iron and later) gives this type."""
+        return self._typestore.hash_rihs01(type_name)
+
+    def fielddefs(self, type_name: str) -> Any:
+        """Return rosbags' (constants, fields) entry for a registered type."""
+        return self._typestore.fielddefs[type_name]

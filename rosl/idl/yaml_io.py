@@ -1,0 +1,171 @@
+"""Messages to and from YAML, CSV and plain dicts, with ROS 2's formatting rules.
+
+Output matches rosidl_runtime_py (what ``ros2 topic echo`` and ``ros2 interface proto``
+print): block-style YAML in field order, strings and arrays truncated to ``truncate_length``
+with ``...``, and ``--no-arr``/``--no-str`` placeholders such as
+``<sequence type: double, length: 3>``.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import yaml
+
+from rosl.idl.errors import InterfaceError
+from rosl.idl.messages import Message
+from rosl.idl.parser import ArrayKind, FieldType
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+# rosidl's IDL spelling of each primitive, used in the --no-arr placeholders
+IDL_NAMES = {
+    "bool": "boolean",
+    "byte": "octet",
+    "char": "uint8",
+    "float32": "float",
+    "float64": "double",
+}
+
+
+def _array_placeholder(value: Any, ftype: FieldType) -> str:
+    element = IDL_NAMES.get(ftype.base, ftype.base)
+    if ftype.array is ArrayKind.FIXED:
+        return f"<array type: {element}[{ftype.size}]>"
+    if ftype.array is ArrayKind.BOUNDED:
+        return f"<sequence type: {element}[{ftype.size}], length: {len(value)}>"
+    return f"<sequence type: {element}, length: {len(value)}>"
+
+
+def message_to_ordered(
+    message: Message,
+    *,
+    truncate_length: int | None = None,
+    no_arr: bool = False,
+    no_str: bool = False,
+) -> dict[str, Any]:
+    """Return the message as a dict ready for YAML, applying ROS 2's display options."""
+    out: dict[str, Any] = {}
+    for name, ftype in zip(message._fields, message._field_types, strict=True):
+        out[name] = _convert(getattr(message, name), ftype, truncate_length, no_arr, no_str)
+    return out
+
+
+def _convert(
+    value: Any, ftype: FieldType | None, truncate: int | None, no_arr: bool, no_str: bool
+) -> Any:
+    if isinstance(value, str):
+        if no_str:
+            return f"<string length: <{len(value)}>>"
+        if truncate is not None and len(value) > truncate:
+            return value[:truncate] + "..."
+        return value
+    if isinstance(value, (list, tuple, np.ndarray)):
+        if no_arr and ftype is not None:
+            return _array_placeholder(value, ftype)
+        items = value.tolist() if isinstance(value, np.ndarray) else list(value)
+        if truncate is not None and len(items) > truncate:
+            return [_convert(v, None, truncate, no_arr, no_str) for v in items[:truncate]] + ["..."]
+        return [_convert(v, None, truncate, no_arr, no_str) for v in items]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Message):
+        return message_to_ordered(value, truncate_length=truncate, no_arr=no_arr, no_str=no_str)
+    return value
+
+
+class _Dumper(yaml.SafeDumper):
+    """PyYAML's safe dumper; dicts keep insertion (field) order."""
+
+
+def dump_yaml(data: Any, *, flow_style: bool = False) -> str:
+    """Dump data the way rosidl_runtime_py does (no line wrapping, unicode kept)."""
+    return yaml.dump(  # type: ignore[no-any-return]
+        data,
+        Dumper=_Dumper,
+        allow_unicode=True,
+        width=sys.maxsize,
+        default_flow_style=flow_style,
+        sort_keys=False,
+    )
+
+
+def message_to_yaml(
+    message: Message,
+    *,
+    truncate_length: int | None = None,
+    no_arr: bool = False,
+    no_str: bool = False,
+    flow_style: bool = False,
+) -> str:
+    """Return the YAML text ``ros2 topic echo`` prints for a message (without ``---``)."""
+    data = message_to_ordered(
+        message, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str
+    )
+    return dump_yaml(data, flow_style=flow_style)
+
+
+def message_to_csv(
+    message: Message,
+    *,
+    truncate_length: int | None = None,
+    no_arr: bool = False,
+    no_str: bool = False,
+) -> str:
+    """Return the comma-separated leaf values ``ros2 topic echo --csv`` prints."""
+
+    def text(value: Any, ftype: FieldType | None) -> str:
+        if isinstance(value, (list, tuple, np.ndarray)):
+            if no_arr and ftype is not None:
+                return _array_placeholder(value, ftype)
+            parts: list[str] = []
+            for index, item in enumerate(value):
+                if truncate_length is not None and index >= truncate_length:
+                    parts.append("...")
+                    break
+                parts.append(text(item, None))
+            return ",".join(parts)
+        if isinstance(value, Message):
+            return message_to_csv(
+                value, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str
+            )
+        if isinstance(value, str):
+            if no_str:
+                return f"<string length: <{len(value)}>>"
+            if truncate_length is not None and len(value) > truncate_length:
+                return value[:truncate_length] + "..."
+        if isinstance(value, np.generic):
+            value = value.item()
+        return str(value)
+
+    return ",".join(
+        text(getattr(message, name), ftype)
+        for name, ftype in zip(message._fields, message._field_types, strict=True)
+    )
+
+
+def parse_yaml_mapping(text: str | None, what: str = "values") -> Mapping[str, Any]:
+    """Parse the YAML a user typed for a message (``"{data: 'hi'}"``); empty means ``{}``.
+
+    Raises:
+        InterfaceError: not YAML, or not a mapping of field names to values.
+    """
+    if text is None or not text.strip():
+        return {}
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise InterfaceError(f"the {what} are not valid YAML{where}: {problem}: {text}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise InterfaceError(
+            f'the {what} must be a YAML mapping like "{{field: value}}", got: {text}'
+        )
+    return data
