@@ -106,6 +106,8 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
     dtype = np.dtype(DTYPES[ftype.base])
     kinds = "b" if ftype.base == "bool" else "iu" if ftype.base in INTEGER_RANGES else "biuf"
     low, high = INTEGER_RANGES.get(ftype.base, (0, 0))
+    if ftype.base == "byte":
+        low = -128
     eight_bit = ftype.base in ("uint8", "byte", "char")
 
     def coerce(value: Any) -> Any:
@@ -117,6 +119,18 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
             array = np.frombuffer(bytes(value), dtype=dtype).copy()
         else:
             raw = np.asarray(value)
+            if kinds == "iu" and raw.dtype.kind in "fO" and raw.ndim == 1 and raw.size:
+                # numpy guesses float64 for ints beyond int64: check the Python ints exactly
+                items = [] if isinstance(value, np.ndarray) else list(value)
+                if not items or not all(
+                    isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in items
+                ):
+                    raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
+                if min(items) < low or max(items) > high:
+                    raise FieldError(
+                        f"{where}: values must lie in {low} to {high} for {ftype.base}"
+                    )
+                raw = np.array(items, dtype=np.uint64 if min(items) >= 0 else np.int64)
             if raw.size == 0:
                 array = np.zeros(0, dtype)
             elif raw.ndim != 1 or raw.dtype.kind not in kinds:
@@ -126,6 +140,8 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
                     raise FieldError(
                         f"{where}: values must lie in {low} to {high} for {ftype.base}"
                     )
+                if ftype.base == "byte":  # 0..255 as ROS writes it, stored as rosbags' int8
+                    raw = (raw.astype(np.int64) & 0xFF).astype(np.uint8)
                 array = raw.astype(dtype)
         if ftype.array is ArrayKind.FIXED and len(array) != ftype.size:
             raise FieldError(f"{where}: needs exactly {ftype.size} values, got {len(array)}")

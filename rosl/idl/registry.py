@@ -265,3 +265,14 @@ def interface_packages(kinds: tuple[str, ...] = KINDS) -> list[str]:
         for package in sorted(result.packages)
         if any(list_types(package, kind) for kind in kinds)
     ]
+
+
+def clear() -> None:
+    """Forget every loaded type and class (later lookups read the files again)."""
+    global _store
+    with _lock:
+        _specs.clear()
+        _classes.clear()
+        _services.clear()
+        _store = None
+    search_path.rescan()

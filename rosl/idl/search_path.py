@@ -123,11 +123,11 @@ def read_package_name(manifest: Path) -> str:
 
 
 def _scan(root: Path, depth: int) -> list[Path]:
-    if not root.is_dir():
+    if not root.is_dir() or any((root / m).exists() for m in _IGNORE_MARKERS):
         return []
     if (root / MANIFEST).is_file():
         return [root]
-    if depth <= 0 or any((root / m).exists() for m in _IGNORE_MARKERS):
+    if depth <= 0:
         return []
     found: list[Path] = []
     try:

@@ -1,0 +1,122 @@
+"""The fixed header every rosl datagram starts with (48 bytes, little endian).
+
+========  =====  ==========================================================================
+field     bytes  meaning
+========  =====  ==========================================================================
+magic     2      ``b"RL"``: anything else is foreign traffic and dropped
+version   1      protocol version (1)
+kind      1      :class:`Kind`
+flags     1      :class:`Flags`
+-         1      reserved (0)
+count     2      number of fragments of the message (1 when it fits one datagram)
+sender    8      random id of the sending process
+seq       4      per-endpoint sequence number (wraps at 2**32)
+topic     8      FNV-1a 64 hash of the topic or service name
+type      4      FNV-1a 32 hash of the type name (mismatches are dropped, not decoded)
+index     2      this fragment's index
+endpoint  2      the sending endpoint's number within its process
+total     4      the whole message's payload size
+stamp     8      send time, integer nanoseconds since the epoch
+========  =====  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import enum
+import struct
+from typing import NamedTuple
+
+MAGIC = b"RL"
+VERSION = 1
+HEADER = struct.Struct("<2sBBBxHQIQIHHIq")
+HEADER_SIZE = HEADER.size
+# Addressed datagrams (a service response, a history replay) start their payload with this:
+# target process id, target endpoint, correlation (the request's sequence number)
+ADDRESS = struct.Struct("<QHxxI")
+ADDRESS_SIZE = ADDRESS.size
+
+_FNV64_OFFSET = 0xCBF29CE484222325
+_FNV64_PRIME = 0x100000001B3
+_FNV32_OFFSET = 0x811C9DC5
+_FNV32_PRIME = 0x01000193
+
+
+class Kind(enum.IntEnum):
+    """What a datagram carries."""
+
+    DATA = 1  # a message on a topic
+    REQUEST = 2  # a service request
+    RESPONSE = 3  # a service response (addressed to the client)
+    DISCOVERY = 4  # node announcements, graph queries, goodbyes
+    REPLAY = 5  # transient-local history for one late subscriber (addressed)
+
+
+class Flags(enum.IntFlag):
+    """Per-datagram flags."""
+
+    NONE = 0
+    ADDRESSED = 1  # the payload starts with an ADDRESS record
+
+
+class Header(NamedTuple):
+    """A decoded datagram header."""
+
+    magic: bytes
+    version: int
+    kind: int
+    flags: int
+    count: int
+    sender: int
+    seq: int
+    topic: int
+    type: int
+    index: int
+    endpoint: int
+    total: int
+    stamp: int
+
+
+def topic_hash(name: str) -> int:
+    """FNV-1a 64 of a topic or service name."""
+    value = _FNV64_OFFSET
+    for byte in name.encode():
+        value = ((value ^ byte) * _FNV64_PRIME) & 0xFFFFFFFFFFFFFFFF
+    return value
+
+
+def type_hash(name: str) -> int:
+    """FNV-1a 32 of a canonical type name."""
+    value = _FNV32_OFFSET
+    for byte in name.encode():
+        value = ((value ^ byte) * _FNV32_PRIME) & 0xFFFFFFFF
+    return value
+
+
+def pack(
+    kind: int,
+    sender: int,
+    seq: int,
+    topic: int,
+    type_: int,
+    endpoint: int,
+    total: int,
+    stamp: int,
+    *,
+    flags: int = 0,
+    count: int = 1,
+    index: int = 0,
+) -> bytes:
+    """Pack one header."""
+    return HEADER.pack(
+        MAGIC, VERSION, kind, flags, count, sender, seq, topic, type_, index, endpoint, total, stamp
+    )
+
+
+def unpack(data: bytes | bytearray | memoryview) -> Header | None:
+    """Unpack a header, or return None for foreign, truncated or future-version datagrams."""
+    if len(data) < HEADER_SIZE or data[0:2] != MAGIC:
+        return None
+    header = Header(*HEADER.unpack_from(data))
+    if header.version != VERSION or header.count == 0 or header.index >= header.count:
+        return None
+    return header

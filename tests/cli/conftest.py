@@ -1,0 +1,78 @@
+"""Ways to run the ``rosl`` command line: in this process (fast) or as a real process."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pytest
+
+from rosl.cli.main import main
+from rosl.idl import registry
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+
+@dataclass(frozen=True)
+class Result:
+    """What one run of ``rosl`` gave back."""
+
+    code: int
+    out: str
+    err: str
+
+    @property
+    def err_lines(self) -> list[str]:
+        return self.err.splitlines()
+
+
+def assert_user_error(result: Result, *fragments: str) -> str:
+    """Check the shape of a user mistake: exit 1, one stderr line, no traceback."""
+    assert result.code == 1, result
+    assert "Traceback" not in result.out + result.err
+    assert len(result.err_lines) == 1, result.err
+    line = result.err_lines[0]
+    for fragment in fragments:
+        assert fragment in line, line
+    return line
+
+
+@pytest.fixture
+def rosl(capsys: pytest.CaptureFixture[str]) -> Callable[..., Result]:
+    """Run ``rosl ARGS`` in this process (fresh caches) and capture what it prints."""
+
+    def run(*args: str) -> Result:
+        registry.clear()
+        capsys.readouterr()
+        code = main(list(args))
+        captured = capsys.readouterr()
+        return Result(code, captured.out, captured.err)
+
+    return run
+
+
+@pytest.fixture
+def rosl_process() -> Callable[..., Result]:
+    """Run the real ``rosl`` (``python -m rosl``) as a process."""
+
+    def run(*args: str, cwd: Path | None = None, stdin: str | None = None) -> Result:
+        env = dict(os.environ)
+        env["NO_COLOR"] = "1"
+        done = subprocess.run(
+            [sys.executable, "-m", "rosl", *args],
+            cwd=cwd or Path.cwd(),
+            input=stdin if stdin is not None else "",
+            capture_output=True,
+            text=True,
+            timeout=60,
+            env=env,
+            check=False,
+        )
+        return Result(done.returncode, done.stdout, done.stderr)
+
+    return run
