@@ -23,6 +23,8 @@ class _BuildPyWithData(build_py):
             return
         root = Path(__file__).resolve().parent
         for name in _SHIPPED:
+            if not (root / name).is_dir():
+                continue  # e.g. a fresh clone where git kept no empty folder
             target = Path(self.build_lib) / "rosl" / "_data" / name
             if target.exists():
                 shutil.rmtree(target)

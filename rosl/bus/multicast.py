@@ -1,0 +1,172 @@
+"""Domain → groups and port, and the UDP multicast sockets (loopback, TTL 0, by default).
+
+See the package docstring for the address plan. Receive buffers are enlarged to 8 MiB where
+the OS allows; when it grants less than 1 MiB a single warning line says how to raise it.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import ipaddress
+import os
+import socket
+import struct
+import sys
+from dataclasses import dataclass
+
+from rosl.bus.errors import BusError
+
+BASE_PORT = 17400
+CHANNELS = 64  # data channels per domain; channel 0 is discovery
+MAX_DOMAIN = 232
+RCVBUF_WANTED = 8 * 1024 * 1024
+RCVBUF_WARN_BELOW = 1024 * 1024
+IP_MULTICAST_ALL = 49  # linux/in.h; not exported by the socket module
+LOOPBACK = "127.0.0.1"
+FIX_HINT = (
+    "check that the loopback interface is up (`ip link set lo up`), or set "
+    "ROSL_INTERFACE to an interface that carries multicast"
+)
+_warned_rcvbuf = False
+
+
+@dataclass(frozen=True, slots=True)
+class Addressing:
+    """Where one domain's traffic goes.
+
+    Attributes:
+        domain: the domain id.
+        interface: the IPv4 address multicast is sent from and joined on.
+        ttl: 0 keeps datagrams on this host; 1 lets them reach the local network.
+    """
+
+    domain: int
+    interface: str = LOOPBACK
+    ttl: int = 0
+
+    @property
+    def port(self) -> int:
+        """The UDP port of this domain."""
+        return BASE_PORT + self.domain
+
+    def group(self, channel: int) -> str:
+        """The multicast group of a channel (0 = discovery, 1..CHANNELS = data)."""
+        return f"239.255.{self.domain}.{channel}"
+
+    @property
+    def max_datagram(self) -> int:
+        """The largest datagram we send: 64 KiB on loopback, one Ethernet frame otherwise."""
+        return 65000 if self.interface == LOOPBACK else 1472
+
+
+def domain_from_env(value: int | str | None = None) -> int:
+    """Return the domain id from ``value``, ``ROSL_DOMAIN_ID``, ``ROS_DOMAIN_ID`` or 0.
+
+    Raises:
+        BusError: not a whole number from 0 to 232.
+    """
+    source = "--domain-id"
+    if value is None:
+        for name in ("ROSL_DOMAIN_ID", "ROS_DOMAIN_ID"):
+            if os.environ.get(name, "").strip():
+                value, source = os.environ[name].strip(), name
+                break
+        else:
+            return 0
+    try:
+        domain = int(value)
+    except (TypeError, ValueError):
+        raise BusError(
+            f"{source}={value!r} is not a domain id (a number from 0 to {MAX_DOMAIN})"
+        ) from None
+    if not 0 <= domain <= MAX_DOMAIN:
+        raise BusError(f"{source}={domain} is out of range: domain ids go from 0 to {MAX_DOMAIN}")
+    return domain
+
+
+def interface_address(name: str) -> str:
+    """Return the IPv4 address of an interface given by name or address.
+
+    Raises:
+        BusError: no such interface, or it has no IPv4 address.
+    """
+    try:
+        return str(ipaddress.IPv4Address(name))
+    except ValueError:
+        pass
+    probe = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        packed = fcntl.ioctl(probe.fileno(), 0x8915, struct.pack("256s", name.encode()[:15]))
+    except OSError as err:
+        raise BusError(
+            f"ROSL_INTERFACE={name}: no such interface with an IPv4 address ({err.strerror})"
+        ) from None
+    finally:
+        probe.close()
+    return socket.inet_ntoa(packed[20:24])
+
+
+def addressing_from_env(domain: int | str | None = None) -> Addressing:
+    """Build the addressing for this process from the environment (and an explicit domain)."""
+    chosen = domain_from_env(domain)
+    interface = os.environ.get("ROSL_INTERFACE", "").strip()
+    if not interface:
+        return Addressing(chosen)
+    address = interface_address(interface)
+    return Addressing(chosen, address, 0 if address.startswith("127.") else 1)
+
+
+def open_sender(addressing: Addressing) -> socket.socket:
+    """Open the socket all of a process's datagrams leave through."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        sock.setsockopt(
+            socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(addressing.interface)
+        )
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, addressing.ttl)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, RCVBUF_WANTED)
+    except OSError as err:
+        sock.close()
+        raise BusError(
+            f"cannot send multicast from {addressing.interface} ({err.strerror}); {FIX_HINT}"
+        ) from None
+    return sock
+
+
+def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
+    """Open a non-blocking socket that receives one channel's group of the domain."""
+    group = addressing.group(channel)
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        sock.setsockopt(socket.IPPROTO_IP, IP_MULTICAST_ALL, 0)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RCVBUF_WANTED)
+        sock.bind(("", addressing.port))
+        membership = struct.pack(
+            "4s4s", socket.inet_aton(group), socket.inet_aton(addressing.interface)
+        )
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+    except OSError as err:
+        sock.close()
+        raise BusError(
+            f"cannot join multicast group {group} on {addressing.interface} port "
+            f"{addressing.port} ({err.strerror}); {FIX_HINT}"
+        ) from None
+    sock.setblocking(False)
+    _check_rcvbuf(sock)
+    return sock
+
+
+def _check_rcvbuf(sock: socket.socket) -> None:
+    global _warned_rcvbuf
+    granted = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2  # linux reports double
+    if granted < RCVBUF_WARN_BELOW and not _warned_rcvbuf:
+        _warned_rcvbuf = True
+        print(
+            f"rosl: warning: the OS allows only {granted // 1024} KiB of receive buffer "
+            f"(wanted {RCVBUF_WANTED // 1024 // 1024} MiB); fast or large topics may lose "
+            f"messages. Raise it: sudo sysctl -w net.core.rmem_max={RCVBUF_WANTED}",
+            file=sys.stderr,
+        )

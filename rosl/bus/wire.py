@@ -1,0 +1,216 @@
+"""Messages ↔ datagrams: headers, sequence numbers, fragments, early filtering, loss counts.
+
+A :class:`Writer` sends the messages of one endpoint (a publisher, a service client or
+server). A :class:`Reader` drains channel sockets: foreign datagrams and topics nobody in the
+process wants are dropped after the header is read, fragments are reassembled, and each
+publisher stream's sequence numbers are checked so every gap is counted — loss is never
+silent. Callbacks run on the thread that reads the socket; nothing is handed off.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple
+
+from rosl.bus import header as hdr
+from rosl.bus.fragment import Reassembler, split
+from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
+from rosl.bus.transport import channel_of
+
+if TYPE_CHECKING:
+    import socket
+
+    from rosl.bus.transport import Buffer, Transport
+
+_SMALL = 2048  # below this, joining header and payload beats a scatter send
+_unpack_header = HEADER.unpack_from
+_MAGIC = hdr.MAGIC
+_VERSION = hdr.VERSION
+
+
+class Delivery(NamedTuple):
+    """A complete message received from the bus."""
+
+    kind: int
+    sender: int
+    endpoint: int
+    seq: int
+    topic: int
+    type: int
+    stamp: int  # send time (ns)
+    received: int  # receive time (ns), taken when the last datagram was read
+    payload: bytes | bytearray
+    address: tuple[int, int, int] | None = None  # (process, endpoint, correlation)
+
+
+@dataclass(slots=True)
+class StreamStats:
+    """What one subscriber-side process saw of one publisher's stream."""
+
+    topic: int
+    received: int = 0
+    lost: int = 0
+    last_seq: int = 0
+    last_received: int = 0
+
+
+class Writer:
+    """Sends the messages of one endpoint on the channel of its topic or service."""
+
+    def __init__(
+        self,
+        transport: Transport,
+        sender: int,
+        endpoint: int,
+        name: str,
+        type_name: str,
+        kind: Kind = Kind.DATA,
+    ) -> None:
+        self.transport = transport
+        self.sender = sender
+        self.endpoint = endpoint
+        self.kind = kind
+        self.topic = hdr.topic_hash(name)
+        self.type = hdr.type_hash(type_name)
+        self.channel = channel_of(self.topic)
+        self.chunk = transport.max_datagram - HEADER_SIZE
+        self._seq = itertools.count(1)
+        self.sent = 0
+
+    def send(
+        self,
+        payload: Buffer,
+        *,
+        kind: Kind | None = None,
+        address: tuple[int, int, int] | None = None,
+        seq: int | None = None,
+        stamp: int | None = None,
+    ) -> int:
+        """Send one message; return its sequence number.
+
+        Args:
+            payload: the message bytes (CDR).
+            kind: overrides the writer's kind (e.g. REPLAY for a publisher).
+            address: (process, endpoint, correlation) for a message meant for one endpoint.
+            seq: reuse a sequence number (a replayed message keeps its original one).
+            stamp: the send time to record (ns); now by default.
+        """
+        number = (next(self._seq) if seq is None else seq) & 0xFFFFFFFF
+        flags = 0
+        if address is not None:
+            payload = ADDRESS.pack(*address) + bytes(payload)
+            flags = Flags.ADDRESSED
+        total = len(payload)
+        when = time.time_ns() if stamp is None else stamp
+        kind_value = self.kind if kind is None else kind
+        if total <= self.chunk:
+            head = HEADER.pack(
+                _MAGIC, _VERSION, kind_value, flags, 1, self.sender, number, self.topic,
+                self.type, 0, self.endpoint, total, when,
+            )  # fmt: skip
+            if total < _SMALL:
+                self.transport.send(self.channel, [head + bytes(payload)])
+            else:
+                self.transport.send(self.channel, [head, payload])
+        else:
+            for index, count, view in split(payload, self.chunk):
+                head = HEADER.pack(
+                    _MAGIC, _VERSION, kind_value, flags, count, self.sender, number,
+                    self.topic, self.type, index, self.endpoint, total, when,
+                )  # fmt: skip
+                self.transport.send(self.channel, [head, view])
+        self.sent += 1
+        return number
+
+
+class Reader:
+    """Turns the datagrams of channel sockets into complete :class:`Delivery` records."""
+
+    def __init__(self) -> None:
+        self.wanted: set[int] = set()  # topic hashes someone in this process listens to
+        self.want_all = False  # recorders and monitors take every topic
+        self.foreign = 0  # datagrams that are not rosl's (or from another protocol version)
+        self.unwanted = 0  # rosl datagrams of topics nobody here listens to
+        self.streams: dict[tuple[int, int], StreamStats] = {}
+        self.reassembler = Reassembler()
+        self._buffer = bytearray(65536)
+        self._view = memoryview(self._buffer)
+
+    def drain(self, sock: socket.socket, out: list[Delivery], limit: int = 256) -> bool:
+        """Read up to ``limit`` ready datagrams from ``sock`` into ``out``.
+
+        Returns:
+            True when the socket may hold more (the limit was reached).
+        """
+        buffer, view = self._buffer, self._view
+        wanted, want_all = self.wanted, self.want_all
+        recv_into = sock.recv_into
+        for _ in range(limit):
+            try:
+                size = recv_into(buffer)
+            except (BlockingIOError, InterruptedError):
+                return False
+            except OSError:
+                return False  # closed while draining (shutdown)
+            now = time.time_ns()
+            if size < HEADER_SIZE or buffer[0:2] != _MAGIC:
+                self.foreign += 1
+                continue
+            (_, version, kind, flags, count, sender, seq, topic, type_, index,
+             endpoint, total, stamp) = _unpack_header(buffer)  # fmt: skip
+            if version != _VERSION or count == 0 or index >= count:
+                self.foreign += 1
+                continue
+            if not want_all and topic not in wanted:
+                self.unwanted += 1
+                continue
+            if count == 1:
+                if total != size - HEADER_SIZE:
+                    self.reassembler.malformed += 1
+                    continue
+                payload: bytes | bytearray = buffer[HEADER_SIZE:size]
+            else:
+                whole = self.reassembler.add(
+                    hdr.Header(_MAGIC, version, kind, flags, count, sender, seq, topic, type_,
+                               index, endpoint, total, stamp),
+                    view[HEADER_SIZE:size],
+                    now,
+                )  # fmt: skip
+                if whole is None:
+                    continue
+                payload = whole
+            address = None
+            if flags & Flags.ADDRESSED:
+                if len(payload) < ADDRESS_SIZE:
+                    self.reassembler.malformed += 1
+                    continue
+                address = ADDRESS.unpack_from(payload)
+                payload = payload[ADDRESS_SIZE:]
+            if kind == Kind.DATA:
+                self._count(sender, endpoint, topic, seq, now)
+            out.append(
+                Delivery(kind, sender, endpoint, seq, topic, type_, stamp, now, payload, address)
+            )
+        return True
+
+    def _count(self, sender: int, endpoint: int, topic: int, seq: int, now: int) -> None:
+        key = (sender, endpoint)
+        stats = self.streams.get(key)
+        if stats is None:
+            stats = self.streams[key] = StreamStats(topic, last_seq=seq - 1)
+        step = (seq - stats.last_seq) & 0xFFFFFFFF
+        if 0 < step < 0x80000000:
+            stats.lost += step - 1
+            stats.last_seq = seq
+        stats.received += 1
+        stats.last_received = now
+
+    def lost(self, topic: int | None = None) -> int:
+        """Messages lost (sequence gaps) on all streams, or on one topic's streams."""
+        return sum(s.lost for s in self.streams.values() if topic is None or s.topic == topic)
+
+    def received(self, topic: int | None = None) -> int:
+        """Messages received on all streams, or on one topic's streams."""
+        return sum(s.received for s in self.streams.values() if topic is None or s.topic == topic)
