@@ -9,6 +9,7 @@ make the process allocate without bound).
 
 from __future__ import annotations
 
+import mmap
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -34,9 +35,18 @@ def split(
         yield index, count, view[index * chunk : (index + 1) * chunk]
 
 
+LAZY_ABOVE = 1024 * 1024  # bigger buffers are anonymous mmaps: pages are faulted in as written
+
+
+def _buffer(size: int) -> bytearray | mmap.mmap:
+    # bytearray(n) zero-fills every page up front: for 16 MB that stalls the reader for
+    # milliseconds while its socket overflows; an anonymous mmap costs nothing until written
+    return mmap.mmap(-1, size) if size > LAZY_ABOVE else bytearray(size)
+
+
 @dataclass(slots=True)
 class _Partial:
-    buffer: bytearray
+    buffer: bytearray | mmap.mmap
     count: int
     started_ns: int
     received: set[int] = field(default_factory=set)
@@ -54,11 +64,12 @@ class Reassembler:
         self._latest: dict[tuple[int, int, int], tuple[int, int, int, int]] = {}
         self._pending = 0
 
-    def add(self, header: Header, payload: memoryview, now_ns: int) -> bytearray | None:
+    def add(self, header: Header, payload: memoryview, now_ns: int) -> bytearray | mmap.mmap | None:
         """Add one fragment; return the whole payload when this completed it."""
         total, count, index = header.total, header.count, header.index
         size = len(payload)
-        if total > MAX_MESSAGE_SIZE or size > total or size * count < total:
+        last = index == count - 1
+        if total > MAX_MESSAGE_SIZE or size > total or (not last and size * count < total):
             self.malformed += 1
             return None
         key = (header.sender, header.endpoint, header.kind, header.seq)
@@ -71,7 +82,7 @@ class Reassembler:
             return None
         if index in partial.received:
             return None
-        offset = total - size if index == count - 1 else index * size
+        offset = total - size if last else index * size
         if offset < 0 or offset + size > total:
             self.malformed += 1
             return None
@@ -90,7 +101,7 @@ class Reassembler:
         self._latest[stream] = key
         while self._partial and self._pending + total > self.max_pending:
             self._drop(next(iter(self._partial)))
-        self._partial[key] = _Partial(bytearray(total), count, now_ns)
+        self._partial[key] = _Partial(_buffer(total), count, now_ns)
         self._pending += total
 
     def _finish(self, key: tuple[int, int, int, int]) -> None:

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from rosl.bus import multicast
 from rosl.bus.errors import BusError
+from rosl.bus.pacing import Pacer, pacer_from_env
 
 if TYPE_CHECKING:
     import socket
@@ -26,6 +27,7 @@ class Transport(Protocol):
 
     addressing: Addressing
     max_datagram: int
+    pacer: Pacer
 
     def send(self, channel: int, parts: Sequence[Buffer]) -> None:
         """Send one datagram made of ``parts`` to every receiver of ``channel``."""
@@ -43,6 +45,7 @@ class MulticastTransport:
     def __init__(self, addressing: Addressing) -> None:
         self.addressing = addressing
         self.max_datagram = addressing.max_datagram
+        self.pacer = pacer_from_env(addressing.interface == multicast.LOOPBACK)
         self._sender = multicast.open_sender(addressing)
         self._targets = [
             (addressing.group(c), addressing.port) for c in range(multicast.CHANNELS + 1)

@@ -20,6 +20,7 @@ from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, K
 from rosl.bus.transport import channel_of
 
 if TYPE_CHECKING:
+    import mmap
     import socket
 
     from rosl.bus.transport import Buffer, Transport
@@ -41,7 +42,7 @@ class Delivery(NamedTuple):
     type: int
     stamp: int  # send time (ns)
     received: int  # receive time (ns), taken when the last datagram was read
-    payload: bytes | bytearray
+    payload: memoryview | bytearray | mmap.mmap
     address: tuple[int, int, int] | None = None  # (process, endpoint, correlation)
 
 
@@ -115,11 +116,13 @@ class Writer:
             else:
                 self.transport.send(self.channel, [head, payload])
         else:
+            pace = self.transport.pacer
             for index, count, view in split(payload, self.chunk):
                 head = HEADER.pack(
                     _MAGIC, _VERSION, kind_value, flags, count, self.sender, number,
                     self.topic, self.type, index, self.endpoint, total, when,
                 )  # fmt: skip
+                pace.spend(len(view))
                 self.transport.send(self.channel, [head, view])
         self.sent += 1
         return number
@@ -135,31 +138,32 @@ class Reader:
         self.unwanted = 0  # rosl datagrams of topics nobody here listens to
         self.streams: dict[tuple[int, int], StreamStats] = {}
         self.reassembler = Reassembler()
-        self._buffer = bytearray(65536)
-        self._view = memoryview(self._buffer)
 
     def drain(self, sock: socket.socket, out: list[Delivery], limit: int = 256) -> bool:
         """Read up to ``limit`` ready datagrams from ``sock`` into ``out``.
 
+        Each datagram is received into its own buffer, so payloads are zero-copy views that
+        stay valid after the next read.
+
         Returns:
             True when the socket may hold more (the limit was reached).
         """
-        buffer, view = self._buffer, self._view
         wanted, want_all = self.wanted, self.want_all
-        recv_into = sock.recv_into
+        recv = sock.recv
         for _ in range(limit):
             try:
-                size = recv_into(buffer)
+                data = recv(65536)
             except (BlockingIOError, InterruptedError):
                 return False
             except OSError:
                 return False  # closed while draining (shutdown)
             now = time.time_ns()
-            if size < HEADER_SIZE or buffer[0:2] != _MAGIC:
+            size = len(data)
+            if size < HEADER_SIZE or data[0:2] != _MAGIC:
                 self.foreign += 1
                 continue
             (_, version, kind, flags, count, sender, seq, topic, type_, index,
-             endpoint, total, stamp) = _unpack_header(buffer)  # fmt: skip
+             endpoint, total, stamp) = _unpack_header(data)  # fmt: skip
             if version != _VERSION or count == 0 or index >= count:
                 self.foreign += 1
                 continue
@@ -170,12 +174,12 @@ class Reader:
                 if total != size - HEADER_SIZE:
                     self.reassembler.malformed += 1
                     continue
-                payload: bytes | bytearray = buffer[HEADER_SIZE:size]
+                payload: memoryview | bytearray | mmap.mmap = memoryview(data)[HEADER_SIZE:]
             else:
                 whole = self.reassembler.add(
                     hdr.Header(_MAGIC, version, kind, flags, count, sender, seq, topic, type_,
                                index, endpoint, total, stamp),
-                    view[HEADER_SIZE:size],
+                    memoryview(data)[HEADER_SIZE:],
                     now,
                 )  # fmt: skip
                 if whole is None:
@@ -187,7 +191,7 @@ class Reader:
                     self.reassembler.malformed += 1
                     continue
                 address = ADDRESS.unpack_from(payload)
-                payload = payload[ADDRESS_SIZE:]
+                payload = memoryview(payload)[ADDRESS_SIZE:]
             if kind == Kind.DATA:
                 self._count(sender, endpoint, topic, seq, now)
             out.append(
