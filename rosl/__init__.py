@@ -1,21 +1,82 @@
 """rosl: ROS 2's everyday workflow in pure Python.
 
-The public API. Importing rosl is cheap (no numpy, pymunk or mcap) and installs the import
+The public API. ``import rosl`` is cheap (no numpy, pymunk or mcap) and installs the import
 hook that makes ``from geometry_msgs.msg import Twist`` work for every interface package on
-rosl's search path.
+rosl's search path. Nodes are written as in rclpy::
+
+    import rosl
+    from std_msgs.msg import String
+
+    rosl.init()
+    node = rosl.Node("talker")
+    pub = node.create_publisher(String, "chatter", 10)
+    node.create_timer(1.0, lambda: pub.publish(String(data="hello")))
+    rosl.spin(node)
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rosl.compat import install as _install_import_hook
 from rosl.errors import RoslError
+from rosl.executor import Executor, Future, MultiThreadedExecutor, SingleThreadedExecutor
+from rosl.node.client import Client
+from rosl.node.clock import Clock, ClockType, Duration, Time
+from rosl.node.node import Node
+from rosl.node.parameters import Parameter
+from rosl.node.publisher import Publisher
+from rosl.node.qos import QoSProfile
+from rosl.node.service import Service
+from rosl.node.subscription import Subscription
+from rosl.node.timer import Rate, Timer
+from rosl.spin import (
+    create_node,
+    get_default_context,
+    get_global_executor,
+    init,
+    ok,
+    shutdown,
+    spin,
+    spin_once,
+    spin_until_future_complete,
+    try_shutdown,
+)
 
 if TYPE_CHECKING:
     from rosl.idl.messages import Message, ServiceType
 
-__all__ = ["RoslError", "get_interface"]
+__all__ = [
+    "Client",
+    "Clock",
+    "ClockType",
+    "Duration",
+    "Executor",
+    "Future",
+    "MultiThreadedExecutor",
+    "Node",
+    "Parameter",
+    "Publisher",
+    "QoSProfile",
+    "Rate",
+    "RoslError",
+    "Service",
+    "SingleThreadedExecutor",
+    "Subscription",
+    "Time",
+    "Timer",
+    "create_node",
+    "get_default_context",
+    "get_global_executor",
+    "get_interface",
+    "init",
+    "ok",
+    "shutdown",
+    "spin",
+    "spin_once",
+    "spin_until_future_complete",
+    "try_shutdown",
+]
 __version__ = "0.1.0"
 
 _install_import_hook()
@@ -30,7 +91,3 @@ def get_interface(type_name: str) -> type[Message] | type[ServiceType]:
     from rosl.idl.registry import get_interface as _get
 
     return _get(type_name)
-
-
-def __getattr__(name: str) -> Any:
-    raise AttributeError(f"module 'rosl' has no attribute '{name}'")

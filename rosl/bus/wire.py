@@ -68,6 +68,7 @@ class Writer:
         name: str,
         type_name: str,
         kind: Kind = Kind.DATA,
+        channel: int | None = None,
     ) -> None:
         self.transport = transport
         self.sender = sender
@@ -75,7 +76,7 @@ class Writer:
         self.kind = kind
         self.topic = hdr.topic_hash(name)
         self.type = hdr.type_hash(type_name)
-        self.channel = channel_of(self.topic)
+        self.channel = channel_of(self.topic) if channel is None else channel
         self.chunk = transport.max_datagram - HEADER_SIZE
         self._seq = itertools.count(1)
         self.sent = 0

@@ -1,4 +1,4 @@
-"""Message classes generated from parsed specs: construction, ``==``, ``repr``, dicts.
+"""Message classes generated from parsed specs: construction, dict conversion, checks.
 
 A generated class has ``__slots__`` and a compiled ``__init__`` taking every field by keyword
 or in field order (rosbags' deserializer calls ``cls(*values)``), so building a received
@@ -13,16 +13,26 @@ from __future__ import annotations
 import keyword
 import operator
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from rosl.idl.base import Message, ServiceType
 from rosl.idl.errors import FieldError
 from rosl.idl.names import did_you_mean, parse_type_name
 from rosl.idl.parser import FLOATS, INTEGER_RANGES, ArrayKind, FieldType
 
 if TYPE_CHECKING:
     from rosl.idl.parser import MessageSpec
+
+__all__ = [
+    "Message",
+    "ServiceType",
+    "build_message_class",
+    "build_service_class",
+    "from_dict",
+    "to_dict",
+]
 
 DTYPES: dict[str, Any] = {
     "bool": np.bool_,
@@ -41,58 +51,6 @@ DTYPES: dict[str, Any] = {
 }
 _ZERO: dict[str, Any] = {"bool": False, "string": "", **dict.fromkeys(FLOATS, 0.0)}
 DUMMY_FIELD = "structure_needs_at_least_one_member"
-
-
-class Message:
-    """Base of every generated message class."""
-
-    __slots__ = ()
-    __msgtype__: ClassVar[str]
-    _fields: ClassVar[tuple[str, ...]]
-    _field_types: ClassVar[tuple[FieldType, ...]]
-    _field_classes: ClassVar[dict[str, type[Message]]]
-    _python_name: ClassVar[str]
-    _spec: ClassVar[MessageSpec]
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:  # replaced in every subclass
-        raise TypeError("Message is abstract")
-
-    def __eq__(self, other: object) -> bool:
-        if type(other) is not type(self):
-            return NotImplemented
-        return all(_equal(getattr(self, n), getattr(other, n)) for n in self._fields)
-
-    __hash__ = None  # type: ignore[assignment]
-
-    def __repr__(self) -> str:
-        parts = []
-        for name, ftype in zip(self._fields, self._field_types, strict=True):
-            value = getattr(self, name)
-            if isinstance(value, np.ndarray) and ftype.array is not ArrayKind.FIXED:
-                text = repr(value.tolist())
-            else:
-                text = repr(value)
-            parts.append(f"{name}={text}")
-        return f"{self._python_name}({', '.join(parts)})"
-
-    @classmethod
-    def get_fields_and_field_types(cls) -> dict[str, str]:
-        """Return field names and their ROS type spellings, as rclpy does."""
-        return {n: str(t) for n, t in zip(cls._fields, cls._field_types, strict=True)}
-
-
-class ServiceType:
-    """Base of generated service classes: ``Request`` and ``Response`` message classes."""
-
-    __srvtype__: ClassVar[str]
-    Request: ClassVar[type[Message]]
-    Response: ClassVar[type[Message]]
-
-
-def _equal(a: Any, b: Any) -> bool:
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        return bool(np.array_equal(np.asarray(a), np.asarray(b)))
-    return bool(a == b)
 
 
 def _scalar_default(ftype: FieldType, default: Any) -> Any:

@@ -1,0 +1,283 @@
+"""The per-process discovery thread: hello, goodbye, graph queries, and the loopback self-test.
+
+Wire format: JSON objects in ``Kind.DISCOVERY`` datagrams on channel 0, each with an ``op``:
+
+* ``hello``: a process's nodes and endpoints (``records.to_json``), the processes it knows of
+  (``known``) and, when answering a query, the query it answers (``reply_to``);
+* ``bye``: the process is shutting down;
+* ``query``: everyone answers at once with a ``hello``;
+* anything else (e.g. ``replay`` for transient-local history) goes to a registered handler.
+
+A query is complete when every process that anyone reported as known has answered it — so a
+CLI waits exactly as long as the graph needs, with a bound for processes that died.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import json
+import os
+import select
+import socket
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from rosl.bus.errors import BusError
+from rosl.bus.header import Kind
+from rosl.bus.multicast import FIX_HINT
+from rosl.bus.wire import Delivery, Reader, Writer
+from rosl.graph.cache import GraphCache
+from rosl.graph.records import ProcessRecord, from_json, to_json
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.bus.transport import Transport
+    from rosl.graph.records import NodeRecord
+
+DISCOVERY_TOPIC = "@discovery"
+DISCOVERY_TYPE = "rosl/discovery/1"
+PERIOD_S = 1.0
+SELFTEST_S = 2.0
+HOST = socket.gethostname()
+
+
+@dataclass(slots=True)
+class _Query:
+    started: float
+    echoed: float = 0.0
+    responders: set[int] = field(default_factory=set)
+    known: set[int] = field(default_factory=set)
+    last_answer: float = 0.0
+
+
+class Discovery:
+    """Announces this process's nodes and keeps the :class:`GraphCache` of everyone else's."""
+
+    def __init__(
+        self,
+        transport: Transport,
+        sender: int,
+        describe: Callable[[], list[NodeRecord]],
+    ) -> None:
+        self.sender = sender
+        self.cache = GraphCache()
+        self.handlers: dict[str, Callable[[dict[str, Any]], None]] = {}
+        self.loopback_ok = threading.Event()
+        self.malformed = 0
+        self._describe = describe
+        self._transport = transport
+        self._writer = Writer(
+            transport, sender, 0, DISCOVERY_TOPIC, DISCOVERY_TYPE, Kind.DISCOVERY, channel=0
+        )
+        self._reader = Reader()
+        self._reader.wanted.add(self._writer.topic)
+        self._socket = transport.open(0)
+        self._wake_read, self._wake_write = os.pipe()
+        os.set_blocking(self._wake_read, False)
+        os.set_blocking(self._wake_write, False)
+        self._version = itertools.count(1)
+        self._query_ids = itertools.count(1)
+        self._queries: dict[int, _Query] = {}
+        self._lock = threading.Lock()
+        self._announce_due = 0.0
+        self._pending_replies: list[str] = []  # "querier:qid" we still owe an answer
+        self._stopping = False
+        self._started = time.monotonic()
+        self._warned = False
+        self._thread = threading.Thread(target=self._run, name="rosl-discovery", daemon=True)
+
+    # --- lifecycle ---------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start the thread; the first announcement and a graph query go out at once."""
+        self._thread.start()
+        self.changed()
+        self.query()
+
+    def stop(self) -> None:
+        """Say goodbye and stop the thread (idempotent)."""
+        if self._stopping:
+            return
+        self._stopping = True
+        self._send({"op": "bye", "sender": f"{self.sender:016x}"})
+        self._wake()
+        if self._thread.is_alive() and threading.current_thread() is not self._thread:
+            self._thread.join(timeout=2.0)
+        for fd in (self._wake_read, self._wake_write):
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+    def changed(self) -> None:
+        """Local nodes changed: announce them now."""
+        self._announce_due = 0.0
+        self._wake()
+
+    def _wake(self) -> None:
+        with contextlib.suppress(OSError):
+            os.write(self._wake_write, b"x")
+
+    # --- queries -----------------------------------------------------------------------------
+
+    def query(self) -> int:
+        """Ask every process to announce itself now; return the query's id."""
+        qid = next(self._query_ids)
+        with self._lock:
+            self._queries[qid] = _Query(time.monotonic())
+        self._send({"op": "query", "qid": qid, "sender": f"{self.sender:016x}"})
+        return qid
+
+    def wait_complete(self, qid: int, timeout: float = 1.0, quiet: float = 0.15) -> bool:
+        """Wait until query ``qid`` is answered by every process anyone knows of.
+
+        Args:
+            qid: from :meth:`query`.
+            timeout: the bound on the whole wait (seconds).
+            quiet: when nobody at all answers, how long after our own query came back to
+                conclude the graph is empty.
+
+        Returns:
+            True when complete, False when the bound was hit (some process did not answer).
+
+        Raises:
+            BusError: our own query never came back: multicast does not work here.
+        """
+        deadline = time.monotonic() + timeout
+        echo_deadline = time.monotonic() + max(timeout, 1.0)
+        while True:
+            with self._lock:
+                state = self._queries[qid]
+                echoed, answered = state.echoed, set(state.responders)
+                known = state.known | answered
+            now = time.monotonic()
+            if echoed:
+                if answered and known <= answered:
+                    return True
+                if not answered and now - echoed >= quiet:
+                    return True
+                if now >= deadline:
+                    return False
+            elif now >= echo_deadline:
+                raise BusError(self.selftest_message())
+            time.sleep(0.002)
+
+    def selftest_message(self) -> str:
+        """The one-line explanation when our own datagrams do not come back."""
+        where = self._transport.addressing
+        return (
+            f"multicast does not work here: this process never received its own datagram on "
+            f"{where.group(0)}:{where.port} via {where.interface}; {FIX_HINT}"
+        )
+
+    def send(self, message: dict[str, Any]) -> None:
+        """Send another op (e.g. ``replay``) to every process."""
+        self._send(message)
+
+    # --- the thread --------------------------------------------------------------------------
+
+    def _send(self, message: dict[str, Any]) -> None:
+        data = json.dumps(message, separators=(",", ":")).encode()
+        try:
+            self._writer.send(data)
+        except BusError:
+            if not self._stopping:
+                raise
+
+    def _announce(self, reply_to: list[str]) -> None:
+        nodes = tuple(self._describe())
+        if not nodes:
+            return
+        record = ProcessRecord(self.sender, os.getpid(), HOST, nodes, next(self._version))
+        known = [f"{s:016x}" for s in self.cache.senders()]
+        self._send(
+            {"op": "hello", "process": to_json(record), "known": known, "reply_to": reply_to}
+        )
+
+    def _run(self) -> None:
+        deliveries: list[Delivery] = []
+        while not self._stopping:
+            now = time.monotonic()
+            if self._announce_due <= now or self._pending_replies:
+                replies, self._pending_replies = self._pending_replies, []
+                self._announce_due = now + PERIOD_S
+                try:
+                    self._announce(replies)
+                except Exception as err:
+                    print(f"rosl: discovery: cannot announce: {err}", file=sys.stderr)
+            self.cache.expire(now)
+            self._check_selftest(now)
+            wait = max(0.0, min(self._announce_due - time.monotonic(), 0.5))
+            try:
+                ready, _, _ = select.select([self._socket, self._wake_read], [], [], wait)
+            except (OSError, ValueError):
+                return  # closed during shutdown
+            if self._wake_read in ready:
+                try:
+                    while os.read(self._wake_read, 512):
+                        pass
+                except OSError:
+                    pass
+            if self._socket in ready:
+                deliveries.clear()
+                while self._reader.drain(self._socket, deliveries):
+                    pass
+                for delivery in deliveries:
+                    self._handle(delivery)
+
+    def _check_selftest(self, now: float) -> None:
+        if self.loopback_ok.is_set() or self._warned or now - self._started < SELFTEST_S:
+            return
+        self._warned = True
+        print(f"rosl: error: {self.selftest_message()}", file=sys.stderr)
+
+    def _handle(self, delivery: Delivery) -> None:
+        try:
+            message = json.loads(bytes(delivery.payload))
+            op = message["op"]
+        except (ValueError, KeyError, TypeError):
+            self.malformed += 1
+            return
+        if delivery.sender == self.sender:
+            self.loopback_ok.set()
+        try:
+            if op == "hello":
+                self._on_hello(message, delivery.sender)
+            elif op == "bye":
+                self.cache.remove(int(message["sender"], 16))
+            elif op == "query":
+                self._on_query(message, delivery.sender)
+            elif op in self.handlers:
+                self.handlers[op](message)
+        except (ValueError, KeyError, TypeError, AttributeError):
+            self.malformed += 1
+
+    def _on_hello(self, message: dict[str, Any], sender: int) -> None:
+        record = from_json(message["process"], time.monotonic())
+        if record.sender != sender:
+            self.malformed += 1
+            return
+        self.cache.update(record)
+        known = {int(s, 16) for s in message.get("known", [])}
+        mine = f"{self.sender:016x}:"
+        with self._lock:
+            for answered in message.get("reply_to") or []:
+                if not str(answered).startswith(mine):
+                    continue
+                state = self._queries.get(int(str(answered)[len(mine) :]))
+                if state is not None:
+                    state.responders.add(sender)
+                    state.known |= known
+                    state.last_answer = time.monotonic()
+
+    def _on_query(self, message: dict[str, Any], sender: int) -> None:
+        qid = int(message["qid"])
+        if sender == self.sender:
+            with self._lock:
+                state = self._queries.get(qid)
+                if state is not None and not state.echoed:
+                    state.echoed = time.monotonic()
+        self._pending_replies.append(f"{sender:016x}:{qid}")

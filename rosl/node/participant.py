@@ -1,0 +1,201 @@
+"""This process on the bus: transport, discovery, endpoint numbers, and dispatch.
+
+One participant per process (created with the first node, or by a CLI that only observes).
+Its channel sockets are read on the thread that spins — deliveries go straight to the
+endpoint's handler, with no thread hand-off. The discovery thread answers graph queries even
+while the user's callbacks run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import os
+import select
+import threading
+from typing import TYPE_CHECKING, Protocol
+
+from rosl.bus.multicast import addressing_from_env
+from rosl.bus.transport import MulticastTransport, channel_of
+from rosl.bus.wire import Delivery, Reader
+from rosl.graph.announce import Discovery
+
+if TYPE_CHECKING:
+    import socket
+    from collections.abc import Callable
+
+    from rosl.graph.cache import GraphCache
+    from rosl.graph.records import NodeRecord
+
+
+class Handler(Protocol):
+    """Something that takes deliveries for one topic or service hash."""
+
+    def deliver(self, delivery: Delivery) -> None:
+        """Handle one complete message."""
+
+
+class Participant:
+    """The process's presence on one domain."""
+
+    def __init__(self, domain: int | str | None = None) -> None:
+        self.transport = MulticastTransport(addressing_from_env(domain))
+        self.sender = int.from_bytes(os.urandom(8), "little") | 1
+        self.reader = Reader()
+        self._endpoint_ids = itertools.count(1)
+        self._node_ids = itertools.count(1)
+        self._describers: dict[int, Callable[[], NodeRecord]] = {}
+        self._handlers: dict[int, list[Handler]] = {}
+        self._sockets: dict[int, socket.socket] = {}
+        self._deferred: list[Delivery] = []
+        self._lock = threading.RLock()
+        self._wake_read, self._wake_write = os.pipe()
+        os.set_blocking(self._wake_read, False)
+        os.set_blocking(self._wake_write, False)
+        self.discovery = Discovery(self.transport, self.sender, self._describe)
+        self.closed = False
+        self.discovery.start()
+
+    @property
+    def graph(self) -> GraphCache:
+        """What discovery has heard."""
+        return self.discovery.cache
+
+    # --- nodes and endpoints -----------------------------------------------------------------
+
+    def add_node(self, describe: Callable[[], NodeRecord]) -> int:
+        """Register a node (``describe`` returns its current record); return its index."""
+        index = next(self._node_ids)
+        self._describers[index] = describe
+        return index
+
+    def remove_node(self, index: int) -> None:
+        """Forget a node; announce the change."""
+        self._describers.pop(index, None)
+        self.discovery.changed()
+
+    def _describe(self) -> list[NodeRecord]:
+        return [describe() for describe in list(self._describers.values())]
+
+    def next_endpoint(self) -> int:
+        """A new endpoint number, unique in this process."""
+        return next(self._endpoint_ids) & 0xFFFF
+
+    def listen(self, topic: int, handler: Handler) -> None:
+        """Deliver messages of a topic/service hash to ``handler`` (joins its channel)."""
+        with self._lock:
+            self._handlers.setdefault(topic, []).append(handler)
+            self.reader.wanted.add(topic)
+            channel = channel_of(topic)
+            if channel not in self._sockets:
+                self._sockets[channel] = self.transport.open(channel)
+        self.wake()
+
+    def unlisten(self, topic: int, handler: Handler) -> None:
+        """Stop delivering a topic/service hash to ``handler``."""
+        with self._lock:
+            handlers = self._handlers.get(topic, [])
+            if handler in handlers:
+                handlers.remove(handler)
+            if not handlers:
+                self._handlers.pop(topic, None)
+                if not self.reader.want_all:
+                    self.reader.wanted.discard(topic)
+
+    def listen_all(self) -> None:
+        """Receive every topic on every channel (for recorders and monitors)."""
+        from rosl.bus.multicast import CHANNELS
+
+        with self._lock:
+            self.reader.want_all = True
+            for channel in range(1, CHANNELS + 1):
+                if channel not in self._sockets:
+                    self._sockets[channel] = self.transport.open(channel)
+
+    # --- receiving ---------------------------------------------------------------------------
+
+    def wake(self) -> None:
+        """Wake a thread blocked in :meth:`poll`."""
+        with contextlib.suppress(OSError):
+            os.write(self._wake_write, b"x")
+
+    def poll(self, timeout: float | None, sink: Callable[[Delivery], None] | None = None) -> int:
+        """Wait up to ``timeout`` for datagrams, then dispatch every complete message.
+
+        Args:
+            timeout: seconds to wait (None: until something arrives or a wake-up).
+            sink: receives every delivery instead of the registered handlers (monitors).
+
+        Returns:
+            How many messages were dispatched.
+        """
+        if self.closed:
+            return 0
+        with self._lock:
+            sockets = list(self._sockets.values())
+            pending, self._deferred = self._deferred, []
+        if pending:
+            timeout = 0.0
+        try:
+            ready, _, _ = select.select([*sockets, self._wake_read], [], [], timeout)
+        except (OSError, ValueError):
+            return 0  # a socket closed under us (shutdown)
+        if self._wake_read in ready:
+            try:
+                while os.read(self._wake_read, 4096):
+                    pass
+            except OSError:
+                pass
+        deliveries = pending
+        for sock in ready:
+            if sock is not self._wake_read:
+                while self.reader.drain(sock, deliveries):
+                    pass
+        for delivery in deliveries:
+            if sink is not None:
+                sink(delivery)
+            else:
+                self.dispatch(delivery)
+        return len(deliveries)
+
+    def dispatch(self, delivery: Delivery) -> None:
+        """Hand one delivery to the handlers of its topic/service hash."""
+        for handler in self._handlers.get(delivery.topic, ()):
+            handler.deliver(delivery)
+
+    def defer(self, deliveries: list[Delivery]) -> None:
+        """Queue deliveries read by a nested wait for the next :meth:`poll`."""
+        with self._lock:
+            self._deferred.extend(deliveries)
+        self.wake()
+
+    def read_channel(self, channel_topic: int, timeout: float) -> list[Delivery]:
+        """Wait up to ``timeout`` on one topic's channel and return what arrived (undispatched).
+
+        Used by blocking calls (``Client.call``) that must not run other callbacks.
+        """
+        with self._lock:
+            sock = self._sockets.get(channel_of(channel_topic))
+        if sock is None:
+            return []
+        try:
+            ready, _, _ = select.select([sock], [], [], max(0.0, timeout))
+        except (OSError, ValueError):
+            return []
+        found: list[Delivery] = []
+        if ready:
+            while self.reader.drain(sock, found):
+                pass
+        return found
+
+    def close(self) -> None:
+        """Say goodbye and close every socket (idempotent)."""
+        if self.closed:
+            return
+        self.closed = True
+        self.discovery.stop()
+        self.wake()
+        self.transport.close()
+        for fd in (self._wake_read, self._wake_write):
+            with contextlib.suppress(OSError):
+                os.close(fd)

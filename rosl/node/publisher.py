@@ -1,0 +1,87 @@
+"""Publishers: serialize once, send on the topic's channel, keep history when transient-local."""
+
+from __future__ import annotations
+
+import collections
+from typing import TYPE_CHECKING
+
+from rosl.bus.header import Kind
+from rosl.bus.wire import Writer
+from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
+from rosl.idl import registry
+
+if TYPE_CHECKING:
+    from rosl.idl.messages import Message
+    from rosl.node.node import Node
+    from rosl.node.qos import QoSProfile
+
+
+class Publisher:
+    """Publishes messages of one type on one topic (rclpy.publisher.Publisher)."""
+
+    def __init__(self, node: Node, msg_type: type[Message], topic: str, qos: QoSProfile) -> None:
+        self.node = node
+        self.msg_type = msg_type
+        self.qos_profile = qos
+        self.topic = topic
+        self.type_name = msg_type.__msgtype__
+        participant = node.participant
+        self.endpoint = participant.next_endpoint()
+        self._writer = Writer(
+            participant.transport, participant.sender, self.endpoint, topic, self.type_name
+        )
+        self._store = registry.store()
+        self._history: collections.deque[tuple[int, int, bytes]] | None = (
+            collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
+        )
+        self.destroyed = False
+
+    @property
+    def topic_name(self) -> str:
+        """The fully qualified topic name."""
+        return self.topic
+
+    def publish(self, msg: Message | bytes | bytearray | memoryview) -> None:
+        """Send one message (or already-serialized CDR bytes); never blocks on subscribers."""
+        if isinstance(msg, (bytes, bytearray, memoryview)):
+            data = bytes(msg)
+        else:
+            if getattr(msg, "__msgtype__", None) != self.type_name:
+                got = getattr(msg, "__msgtype__", type(msg).__name__)
+                raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
+            data = self._store.serialize(msg)
+        seq = self._writer.send(data)
+        if self._history is not None:
+            self._history.append((seq, self._writer.sent, data))
+
+    def replay(self, target: tuple[int, int]) -> None:
+        """Send the kept history to one late subscriber (transient local)."""
+        if self._history is None or self.destroyed:
+            return
+        for seq, _, data in list(self._history):
+            self._writer.send(data, kind=Kind.REPLAY, address=(*target, 0), seq=seq)
+
+    def get_subscription_count(self) -> int:
+        """How many subscriptions the graph shows on this topic."""
+        return self.node.participant.graph.count(SUBSCRIPTION, self.topic)
+
+    def wait_for_subscribers(self, count: int, timeout: float) -> int:
+        """Block until ``count`` subscriptions are matched (or the timeout); return how many."""
+        graph = self.node.participant.graph
+        graph.wait_for(lambda: graph.count(SUBSCRIPTION, self.topic) >= count, timeout)
+        return graph.count(SUBSCRIPTION, self.topic)
+
+    def record(self) -> EndpointRecord:
+        """This publisher as discovery announces it."""
+        return EndpointRecord(
+            PUBLISHER, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
+            {"sent": self._writer.sent},
+        )  # fmt: skip
+
+    def destroy(self) -> None:
+        """Stop publishing (rclpy: node.destroy_publisher)."""
+        self.destroyed = True
+        self.node.destroy_publisher(self)
+
+    def assert_liveliness(self) -> None:
+        """Liveliness is asserted by discovery; nothing to do."""

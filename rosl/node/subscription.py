@@ -1,0 +1,167 @@
+"""Subscriptions: check the type hash, decode, call back — on the thread that read the socket.
+
+A message whose type differs from the subscription's is dropped undecoded and reported once
+(never mis-decoded). Transient-local subscriptions ask publishers for their history when
+created. Callbacks taking two arguments also get the message info (timestamps, sequence).
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections import deque
+from typing import TYPE_CHECKING, Any
+
+from rosl.bus.header import Kind, topic_hash, type_hash
+from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
+from rosl.idl import registry
+from rosl.idl.errors import InterfaceError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.bus.wire import Delivery
+    from rosl.idl.messages import Message
+    from rosl.node.node import Node
+    from rosl.node.qos import QoSProfile
+
+
+def _wants_info(callback: Callable[..., Any]) -> bool:
+    try:
+        params = [
+            p
+            for p in inspect.signature(callback).parameters.values()
+            if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD) and p.default is p.empty
+        ]
+    except (TypeError, ValueError):
+        return False
+    return len(params) >= 2
+
+
+class Subscription:
+    """Receives one topic's messages (rclpy.subscription.Subscription)."""
+
+    def __init__(
+        self,
+        node: Node,
+        msg_type: type[Message],
+        topic: str,
+        callback: Callable[..., Any],
+        qos: QoSProfile,
+        raw: bool = False,
+    ) -> None:
+        self.node = node
+        self.msg_type = msg_type
+        self.topic = topic
+        self.callback = callback
+        self.qos_profile = qos
+        self.raw = raw
+        self.type_name = msg_type.__msgtype__
+        participant = node.participant
+        self.endpoint = participant.next_endpoint()
+        self._sender = participant.sender
+        self._topic_hash = topic_hash(topic)
+        self._type_hash = type_hash(self.type_name)
+        self._with_info = _wants_info(callback)
+        self._store = registry.store()
+        self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
+        self.received = 0
+        self.mismatched = 0
+        self.undecodable = 0
+        self._warned: set[int] = set()
+        self.destroyed = False
+        participant.listen(self._topic_hash, self)
+        if qos.keeps_history:
+            self._request_history()
+
+    @property
+    def topic_name(self) -> str:
+        """The fully qualified topic name."""
+        return self.topic
+
+    def _request_history(self) -> None:
+        self.node.participant.discovery.send(
+            {
+                "op": "replay",
+                "topic": self.topic,
+                "target": [f"{self._sender:016x}", self.endpoint],
+            }
+        )
+
+    def deliver(self, delivery: Delivery) -> None:
+        """Decode one delivery for this topic and call back."""
+        if self.destroyed:
+            return
+        if delivery.kind == Kind.REPLAY:
+            address = delivery.address
+            if address is None or address[0] != self._sender or address[1] != self.endpoint:
+                return
+            key = (delivery.sender, delivery.endpoint, delivery.seq)
+            if key in self._replayed:
+                return
+            self._replayed.append(key)
+        elif delivery.kind != Kind.DATA:
+            return
+        elif self.qos_profile.keeps_history:
+            self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
+        if delivery.type != self._type_hash:
+            self._mismatch(delivery)
+            return
+        if self.raw:
+            message: Any = bytes(delivery.payload)
+        else:
+            try:
+                message = self._store.deserialize(delivery.payload, self.type_name)
+            except InterfaceError as err:
+                self.undecodable += 1
+                if self.undecodable == 1:
+                    self.node.get_logger().warn(f"dropped a message on {self.topic}: {err}")
+                return
+        self.received += 1
+        if self._with_info:
+            info = {
+                "source_timestamp": delivery.stamp,
+                "received_timestamp": delivery.received,
+                "publication_sequence_number": delivery.seq,
+                "reception_sequence_number": self.received,
+                "publisher_gid": (delivery.sender, delivery.endpoint),
+            }
+            self.node.run_callback(lambda: self.callback(message, info), self.topic)
+        else:
+            self.node.run_callback(lambda: self.callback(message), self.topic)
+
+    def _mismatch(self, delivery: Delivery) -> None:
+        self.mismatched += 1
+        if delivery.sender in self._warned:
+            return
+        self._warned.add(delivery.sender)
+        senders = [
+            (node.fqn, e.type)
+            for node, e in self.node.participant.graph.endpoints(PUBLISHER, self.topic)
+            if node.process == delivery.sender and e.type != self.type_name
+        ]
+        who = f" from {senders[0][0]} ({senders[0][1]})" if senders else ""
+        self.node.get_logger().warn(
+            f"subscription on {self.topic} expects {self.type_name} but got a message of another "
+            f"type{who}; dropped without decoding (publisher and subscriber types must match)"
+        )
+
+    @property
+    def lost(self) -> int:
+        """Messages lost on this topic (sequence gaps seen by this process)."""
+        return self.node.participant.reader.lost(self._topic_hash)
+
+    def record(self) -> EndpointRecord:
+        """This subscription as discovery announces it."""
+        return EndpointRecord(
+            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
+            {"received": self.received, "lost": self.lost, "mismatched": self.mismatched},
+        )  # fmt: skip
+
+    def close(self) -> None:
+        """Stop receiving."""
+        self.destroyed = True
+        self.node.participant.unlisten(self._topic_hash, self)
+
+    def destroy(self) -> None:
+        """Stop receiving (rclpy: node.destroy_subscription)."""
+        self.node.destroy_subscription(self)
