@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import sys
 import traceback
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, NodeRecord
@@ -25,6 +26,8 @@ from rosl.node.qos import (
     qos_profile_rosout_default,
     qos_profile_sensor_data,
 )
+
+_ROSL_DIR = str(Path(__file__).resolve().parent.parent)
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
@@ -357,12 +360,15 @@ class Node:
         except Exception as err:
             if self.context.callback_errors == "raise":
                 raise
-            where = traceback.extract_tb(err.__traceback__)[-1]
+            every = traceback.extract_tb(err.__traceback__)
+            frames = [f for f in every if not f.filename.startswith(_ROSL_DIR)] or every
+            where = frames[-1]
             self._logger.error(
                 f"exception in callback for {what}: {type(err).__name__}: {err} "
                 f"(at {where.filename}:{where.lineno} in {where.name}); the node keeps running"
             )
-            traceback.print_exception(err, file=sys.stderr)
+            lines = traceback.format_list(frames) + traceback.format_exception_only(err)
+            sys.stderr.write("Traceback (most recent call last):\n" + "".join(lines))
 
     def _check_duplicate_name(self) -> None:
         self.destroy_timer(self._name_check)

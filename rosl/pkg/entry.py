@@ -16,7 +16,7 @@ def main(argv: list[str]) -> int:
     package_dir, entry, name, *args = argv
     import rosl.compat
 
-    rosl.compat.install()
+    rosl.compat.install(force=True)
     sys.path.insert(0, package_dir)
     sys.argv = [name, *args]
     if entry.endswith(".py") or "/" in entry:

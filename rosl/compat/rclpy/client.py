@@ -1,0 +1,5 @@
+"""rclpy.client."""
+
+from rosl.node.client import Client
+
+__all__ = ["Client"]

@@ -1,0 +1,5 @@
+"""rclpy.context."""
+
+from rosl.node.context import Context
+
+__all__ = ["Context"]

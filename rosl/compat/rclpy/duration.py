@@ -1,0 +1,5 @@
+"""rclpy.duration."""
+
+from rosl.node.clock import Duration
+
+__all__ = ["Duration"]

@@ -1,0 +1,5 @@
+"""rclpy.node."""
+
+from rosl.node.node import Node
+
+__all__ = ["Node"]

@@ -1,0 +1,5 @@
+"""rclpy.parameter."""
+
+from rosl.node.parameters import Parameter, ParameterType
+
+__all__ = ["Parameter", "ParameterType"]

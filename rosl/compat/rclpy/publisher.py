@@ -1,0 +1,5 @@
+"""rclpy.publisher."""
+
+from rosl.node.publisher import Publisher
+
+__all__ = ["Publisher"]

@@ -1,0 +1,41 @@
+"""rclpy.qos."""
+
+from rosl.node.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    LivelinessPolicy,
+    QoSDurabilityPolicy,
+    QoSHistoryPolicy,
+    QoSLivelinessPolicy,
+    QoSPresetProfiles,
+    QoSProfile,
+    QoSReliabilityPolicy,
+    ReliabilityPolicy,
+    qos_profile_action_status_default,
+    qos_profile_parameter_events,
+    qos_profile_parameters,
+    qos_profile_sensor_data,
+    qos_profile_services_default,
+    qos_profile_system_default,
+    qos_profile_unknown,
+)
+
+__all__ = [
+    "DurabilityPolicy",
+    "HistoryPolicy",
+    "LivelinessPolicy",
+    "QoSDurabilityPolicy",
+    "QoSHistoryPolicy",
+    "QoSLivelinessPolicy",
+    "QoSPresetProfiles",
+    "QoSProfile",
+    "QoSReliabilityPolicy",
+    "ReliabilityPolicy",
+    "qos_profile_action_status_default",
+    "qos_profile_parameter_events",
+    "qos_profile_parameters",
+    "qos_profile_sensor_data",
+    "qos_profile_services_default",
+    "qos_profile_system_default",
+    "qos_profile_unknown",
+]

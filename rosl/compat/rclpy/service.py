@@ -1,0 +1,5 @@
+"""rclpy.service."""
+
+from rosl.node.service import Service
+
+__all__ = ["Service"]

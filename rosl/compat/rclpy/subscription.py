@@ -1,0 +1,5 @@
+"""rclpy.subscription."""
+
+from rosl.node.subscription import Subscription
+
+__all__ = ["Subscription"]

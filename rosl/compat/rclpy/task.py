@@ -1,0 +1,5 @@
+"""rclpy.task."""
+
+from rosl.executor import Future
+
+__all__ = ["Future"]

@@ -1,0 +1,5 @@
+"""rclpy.time."""
+
+from rosl.node.clock import Time
+
+__all__ = ["Time"]

@@ -1,0 +1,5 @@
+"""rclpy.timer."""
+
+from rosl.node.timer import Rate, Timer
+
+__all__ = ["Rate", "Timer"]
