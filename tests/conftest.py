@@ -2,6 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -66,3 +74,121 @@ def make_package(workspace: Path) -> Callable[..., Path]:
         return folder
 
     return make
+
+
+# --- the bus: one domain per test, processes ended by pid --------------------------------------
+
+LOCK_DIR = Path("/tmp/rosl-test-domains")
+
+
+@pytest.fixture
+def domain_id(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
+    """A domain id no other test on this machine uses right now (locked by a file)."""
+    LOCK_DIR.mkdir(exist_ok=True)
+    candidates = list(range(20, 233))
+    random.shuffle(candidates)
+    for domain in candidates:
+        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held for the test
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        monkeypatch.setenv("ROSL_DOMAIN_ID", str(domain))
+        monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
+        try:
+            yield domain
+        finally:
+            handle.close()
+        return
+    pytest.fail("no free test domain id")
+
+
+class Processes:
+    """Starts child processes for a test and ends every one of them, by pid, afterwards."""
+
+    def __init__(self) -> None:
+        self.started: list[subprocess.Popen[str]] = []
+
+    def start(
+        self,
+        args: list[str],
+        *,
+        cwd: Path | None = None,
+        env: dict[str, str] | None = None,
+        stdin: int | None = subprocess.DEVNULL,
+    ) -> subprocess.Popen[str]:
+        full_env = {**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})}
+        child = subprocess.Popen(
+            args,
+            cwd=cwd,
+            env=full_env,
+            stdin=stdin,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
+        self.started.append(child)
+        return child
+
+    def python(self, code: str, *args: str, **kwargs: object) -> subprocess.Popen[str]:
+        """Run a Python snippet (rosl imported by the snippet itself)."""
+        return self.start([sys.executable, "-c", code, *args], **kwargs)  # type: ignore[arg-type]
+
+    def rosl(self, *args: str, **kwargs: object) -> subprocess.Popen[str]:
+        """Run the rosl command line."""
+        return self.start([sys.executable, "-m", "rosl", *args], **kwargs)  # type: ignore[arg-type]
+
+    @staticmethod
+    def stop(child: subprocess.Popen[str], timeout: float = 5.0) -> tuple[str, str]:
+        """Ctrl-C a child, then SIGKILL if it does not exit; return its output."""
+        if child.poll() is None:
+            child.send_signal(signal.SIGINT)
+        try:
+            out, err = child.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            out, err = child.communicate(timeout=5)
+        return out, err
+
+    def close(self) -> None:
+        for child in self.started:
+            if child.poll() is None:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(child.pid, signal.SIGKILL)
+                child.kill()
+            with contextlib.suppress(subprocess.TimeoutExpired, ValueError):
+                child.communicate(timeout=5)
+
+
+@pytest.fixture
+def processes(domain_id: int) -> Iterator[Processes]:
+    """Child processes on this test's domain, all ended (by pid) when the test finishes."""
+    group = Processes()
+    try:
+        yield group
+    finally:
+        group.close()
+
+
+def wait_until(predicate: Callable[[], bool], timeout: float = 5.0, interval: float = 0.02) -> bool:
+    """Poll ``predicate`` until true or the (bounded) timeout."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(interval)
+    return predicate()
+
+
+@pytest.fixture
+def ros(domain_id: int) -> Iterator[object]:
+    """rosl initialized in the test process on the test's domain; shut down afterwards."""
+    import rosl
+
+    rosl.init([])
+    try:
+        yield rosl
+    finally:
+        rosl.shutdown()

@@ -1,0 +1,127 @@
+"""Round-trip latency: ping-pong over two topics between two processes, rosl vs raw sockets.
+
+The raw baseline bounces 64 B datagrams between two plain multicast sockets; rosl bounces a
+std_msgs/msg/UInt8MultiArray through publishers, subscriptions and spin_once (serialize,
+send, receive, decode, callback, on both sides). Prints median and p99 in microseconds and
+the ratios, measured in the same run.
+
+    python bench/latency.py [--rounds N] [--size BYTES]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+
+from _harness import BENCH_DOMAIN, finish, raw_receiver, raw_sender, spawn
+
+PORT = 17400 + BENCH_DOMAIN + 2
+PING, PONG = f"239.255.{BENCH_DOMAIN}.21", f"239.255.{BENCH_DOMAIN}.22"
+
+
+def raw_pong() -> None:
+    rx = raw_receiver(PING, PORT)
+    tx = raw_sender()
+    rx.settimeout(5.0)
+    print("ready", flush=True)
+    buf = bytearray(65536)
+    while True:
+        try:
+            n = rx.recv_into(buf)
+        except TimeoutError:
+            return
+        if n == 1:
+            return
+        tx.sendto(buf[:n], (PONG, PORT))
+
+
+def raw_ping(rounds: int, size: int) -> list[float]:
+    rx = raw_receiver(PONG, PORT)
+    tx = raw_sender()
+    rx.settimeout(2.0)
+    payload = bytes(size)
+    buf = bytearray(65536)
+    times = []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        tx.sendto(payload, (PING, PORT))
+        rx.recv_into(buf)
+        times.append(time.perf_counter() - start)
+    tx.sendto(b"x", (PING, PORT))
+    return times
+
+
+def rosl_pong() -> None:
+    import rosl
+    from std_msgs.msg import UInt8MultiArray
+
+    rosl.init([], domain_id=BENCH_DOMAIN)
+    node = rosl.Node("pong")
+    pub = node.create_publisher(UInt8MultiArray, "/bench_pong", 10)
+    node.create_subscription(UInt8MultiArray, "/bench_ping", pub.publish, 10)
+    print("ready", flush=True)
+    rosl.spin(node)  # until the parent's SIGTERM
+    rosl.shutdown()
+
+
+def rosl_ping(rounds: int, size: int) -> list[float]:
+    import rosl
+    from std_msgs.msg import UInt8MultiArray
+
+    rosl.init([], domain_id=BENCH_DOMAIN)
+    node = rosl.Node("ping")
+    pub = node.create_publisher(UInt8MultiArray, "/bench_ping", 10)
+    got: list[float] = []
+    node.create_subscription(UInt8MultiArray, "/bench_pong", lambda m: got.append(time.perf_counter()), 10)
+    executor = rosl.SingleThreadedExecutor()
+    executor.add_node(node)
+    msg = UInt8MultiArray(data=bytes(max(0, size - 16)))
+    deadline = time.monotonic() + 10
+    while node.count_subscribers("/bench_ping") == 0 and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.05)
+    times = []
+    for _ in range(rounds + 50):
+        got.clear()
+        start = time.perf_counter()
+        pub.publish(msg)
+        limit = start + 1.0
+        while not got and time.perf_counter() < limit:
+            executor.spin_once(timeout_sec=0.2)
+        if got:
+            times.append(got[0] - start)
+    rosl.shutdown()
+    return times[50:]
+
+
+def stats(times: list[float]) -> tuple[float, float]:
+    ordered = sorted(times)
+    return statistics.median(ordered) * 1e6, ordered[int(0.99 * (len(ordered) - 1))] * 1e6
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--rounds", type=int, default=3000)
+    parser.add_argument("--size", type=int, default=64)
+    args = parser.parse_args()
+    child = spawn([__file__, "raw_pong"])
+    raw = stats(raw_ping(args.rounds, args.size))
+    finish(child)
+    child = spawn([__file__, "rosl_pong"])
+    ours = stats(rosl_ping(args.rounds, args.size))
+    child.terminate()
+    finish(child)
+    print(f"payload {args.size} B, {args.rounds} round trips, two processes")
+    print(f"{'':8} {'median us':>10} {'p99 us':>8}")
+    print(f"{'raw':8} {raw[0]:>10.1f} {raw[1]:>8.1f}")
+    print(f"{'rosl':8} {ours[0]:>10.1f} {ours[1]:>8.1f}")
+    print(f"ratio rosl/raw: median {ours[0] / raw[0]:.2f} (target <= 1.5), "
+          f"p99 {ours[1] / raw[1]:.2f} (target <= 2.0)")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] in ("raw_pong", "rosl_pong"):
+        globals()[sys.argv[1]]()
+    else:
+        main()
