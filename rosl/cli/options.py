@@ -36,3 +36,14 @@ class GreedyOption(click.Option):
         for item in value or ():
             flat.extend(item if isinstance(item, tuple) else (item,))
         return tuple(flat)
+
+
+def domain_option(command: Any) -> Any:
+    """Add ``--domain-id`` (overrides ROSL_DOMAIN_ID / ROS_DOMAIN_ID) to a command."""
+    return click.option(
+        "--domain-id",
+        "domain_id",
+        type=int,
+        default=None,
+        help="Domain to use instead of ROSL_DOMAIN_ID / ROS_DOMAIN_ID.",
+    )(command)

@@ -29,6 +29,7 @@ class Watched:
     def __init__(self, child: subprocess.Popen[str]) -> None:
         self.child = child
         self.pid = child.pid
+        self.signalled = False
         self._lines: dict[str, list[str]] = {"out": [], "err": []}
         self._changed = threading.Condition()
         self._readers = [
@@ -83,10 +84,16 @@ class Watched:
     def _alive(self) -> bool:
         return any(reader.is_alive() for reader in self._readers)
 
-    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 10.0) -> int | None:
-        """Send ``sig`` (Ctrl-C by default) and wait for the exit; return the exit code."""
+    def send(self, sig: int = signal.SIGINT) -> None:
+        """Send a signal to the child (by pid), once: a second Ctrl-C means "now"."""
         if self.child.poll() is None:
             self.child.send_signal(sig)
+        self.signalled = True
+
+    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 10.0) -> int | None:
+        """Ctrl-C the child (unless already signalled) and wait; return the exit code."""
+        if not self.signalled:
+            self.send(sig)
         try:
             code = self.child.wait(timeout=timeout)
         except subprocess.TimeoutExpired:

@@ -1,0 +1,137 @@
+"""``rosl param``: list, get, set, dump, load, describe, delete."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rosl.cli import render
+from rosl.cli.options import domain_option
+from rosl.errors import RoslError
+from rosl.introspection import params
+from rosl.introspection.session import Session
+
+
+@click.group("param")
+def command() -> None:
+    """Various param related sub-commands."""
+
+
+@command.command("list")
+@click.argument("node_name", required=False)
+@click.option(
+    "--filter",
+    "filter_regex",
+    default=None,
+    help="Only list parameters matching this regular expression",
+)
+@click.option("--param-type", is_flag=True, help="Print parameter types with parameter names")
+@click.option(
+    "--include-hidden-nodes", "include_hidden", is_flag=True, help="Consider hidden nodes as well"
+)
+@domain_option
+def list_(
+    node_name: str | None,
+    filter_regex: str | None,
+    param_type: bool,
+    include_hidden: bool,
+    domain_id: int | None,
+) -> None:
+    """Output a list of available parameters."""
+    with Session(domain_id) as session:
+        render.lines(
+            params.param_list(
+                session,
+                node_name,
+                filter_regex=filter_regex,
+                param_type=param_type,
+                include_hidden=include_hidden,
+            )
+        )
+
+
+@command.command("get")
+@click.argument("node_name")
+@click.argument("parameter_name")
+@click.option("--hide-type", is_flag=True, help="Hide the type information")
+@domain_option
+def get(node_name: str, parameter_name: str, hide_type: bool, domain_id: int | None) -> None:
+    """Get parameter."""
+    with Session(domain_id) as session:
+        render.text(params.get(session, node_name, parameter_name, hide_type=hide_type) + "\n")
+
+
+@command.command("set")
+@click.argument("node_name")
+@click.argument("pairs", nargs=-1, required=True, metavar="NAME VALUE [NAME VALUE ...]")
+@click.option("--atomic", is_flag=True, help="Set all parameters or none")
+@domain_option
+def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | None) -> None:
+    """Set parameter(s); values are YAML (1 int, 1.0 double, true bool, '[1, 2]' array)."""
+    if len(pairs) % 2:
+        raise click.UsageError("give parameters as NAME VALUE pairs")
+    with Session(domain_id) as session:
+        render.lines(
+            params.set_values(
+                session, node_name, list(zip(pairs[::2], pairs[1::2], strict=True)), atomic=atomic
+            )
+        )
+
+
+@command.command("delete")
+@click.argument("node_name")
+@click.argument("parameter_name")
+@domain_option
+def delete(node_name: str, parameter_name: str, domain_id: int | None) -> None:
+    """Delete parameter."""
+    with Session(domain_id) as session:
+        render.text(params.delete(session, node_name, parameter_name) + "\n")
+
+
+@command.command("describe")
+@click.argument("node_name")
+@click.argument("parameter_names", nargs=-1, required=True)
+@domain_option
+def describe(node_name: str, parameter_names: tuple[str, ...], domain_id: int | None) -> None:
+    """Show descriptive information about declared parameters."""
+    with Session(domain_id) as session:
+        render.lines(params.describe(session, node_name, list(parameter_names)))
+
+
+@command.command("dump")
+@click.argument("node_name")
+@click.option(
+    "--output-dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Write <node>.yaml into this folder instead of printing",
+)
+@click.option("--print", "print_", is_flag=True, help="Print (the default; kept for compatibility)")
+@domain_option
+def dump(node_name: str, output_dir: Path | None, print_: bool, domain_id: int | None) -> None:
+    """Show all of the parameters of a node in a YAML file format."""
+    del print_
+    with Session(domain_id) as session:
+        if output_dir is None:
+            render.text(params.dump(session, node_name))
+        else:
+            render.text(f"Saving to:  {params.dump_to_dir(session, node_name, output_dir)}\n")
+
+
+@command.command("load")
+@click.argument("node_name")
+@click.argument("parameter_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option(
+    "--no-use-wildcard", is_flag=True, help="Do not load parameters in the '/**' namespace"
+)
+@domain_option
+def load(node_name: str, parameter_file: Path, no_use_wildcard: bool, domain_id: int | None) -> int:
+    """Load parameter file for a node."""
+    with Session(domain_id) as session:
+        results = params.load(session, node_name, parameter_file, use_wildcard=not no_use_wildcard)
+    for ok, line in results:
+        (render.text if ok else render.warn)(line + ("\n" if ok else ""))
+    if not all(ok for ok, _ in results):
+        raise RoslError("some parameters were not set")
+    return 0

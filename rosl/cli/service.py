@@ -1,0 +1,107 @@
+"""``rosl service``: list, type, find, info, call."""
+
+from __future__ import annotations
+
+import click
+
+from rosl.cli import render
+from rosl.cli.options import domain_option
+from rosl.introspection import services
+from rosl.introspection.session import Session
+
+hidden_option = click.option(
+    "--include-hidden-services",
+    "include_hidden",
+    is_flag=True,
+    help="Consider hidden services as well",
+)
+
+
+@click.group("service")
+def command() -> None:
+    """Various service related sub-commands."""
+
+
+@command.command("list")
+@click.option("-t", "--show-types", is_flag=True, help="Additionally show the service type")
+@click.option(
+    "-c", "--count-services", "count", is_flag=True, help="Only display the number of services"
+)
+@hidden_option
+@domain_option
+def list_(show_types: bool, count: bool, include_hidden: bool, domain_id: int | None) -> None:
+    """Output a list of available services."""
+    with Session(domain_id) as session:
+        render.lines(
+            services.list_services(
+                session, show_types=show_types, count=count, include_hidden=include_hidden
+            )
+        )
+
+
+@command.command("type")
+@click.argument("service_name")
+@domain_option
+def type_(service_name: str, domain_id: int | None) -> None:
+    """Output a service's type."""
+    with Session(domain_id) as session:
+        render.lines(session.service_types(service_name))
+
+
+@command.command("find")
+@click.argument("service_type")
+@click.option(
+    "-c", "--count-services", "count", is_flag=True, help="Only display the number of services"
+)
+@hidden_option
+@domain_option
+def find(service_type: str, count: bool, include_hidden: bool, domain_id: int | None) -> None:
+    """Output a list of available services of a given type."""
+    with Session(domain_id) as session:
+        found = services.find_services(session, service_type, include_hidden=include_hidden)
+        render.lines([str(len(found))] if count else found)
+
+
+@command.command("info")
+@click.argument("service_name")
+@domain_option
+def info(service_name: str, domain_id: int | None) -> None:
+    """Print information about a service."""
+    with Session(domain_id) as session:
+        render.lines(services.service_info(session, service_name))
+
+
+@command.command("call")
+@click.argument("service_name")
+@click.argument("service_type", required=False)
+@click.argument("values", required=False, default="{}")
+@click.option(
+    "-r", "--rate", type=float, default=None, help="Repeat the call at a specific rate in Hz"
+)
+@click.option(
+    "--timeout",
+    type=float,
+    default=services.DEFAULT_TIMEOUT,
+    show_default=True,
+    help="Seconds to wait for the service, and for each response",
+)
+@domain_option
+def call(
+    service_name: str,
+    service_type: str | None,
+    values: str,
+    rate: float | None,
+    timeout: float,
+    domain_id: int | None,
+) -> None:
+    """Call a service (TYPE may be left out: the graph knows it)."""
+    from rosl.idl.yaml_io import parse_yaml_mapping
+
+    if service_type is not None and service_type.lstrip().startswith("{"):
+        service_type, values = None, service_type  # `call /srv "{a: 1}"` without a type
+    data = parse_yaml_mapping(values, "request values")
+    with Session(domain_id) as session:
+        for block in services.call(
+            session, service_name, service_type, data, rate=rate, timeout=timeout
+        ):
+            render.text(block + "\n")

@@ -1,0 +1,105 @@
+"""``topic list/info/type/find``: the graph's topics in ros2cli's text formats."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from rosl.graph.records import PUBLISHER, SUBSCRIPTION, gid
+from rosl.introspection.session import sorted_endpoints, visible
+
+if TYPE_CHECKING:
+    from rosl.graph.records import EndpointRecord, NodeRecord
+    from rosl.introspection.session import Session
+
+
+def list_topics(
+    session: Session,
+    *,
+    show_types: bool = False,
+    count: bool = False,
+    verbose: bool = False,
+    include_hidden: bool = False,
+) -> list[str]:
+    """The lines ``ros2 topic list`` prints."""
+    graph = session.graph()
+    topics = {n: t for n, t in graph.topics().items() if visible(n, include_hidden)}
+    if count:
+        return [str(len(topics))]
+    if not verbose:
+        return [f"{n} [{', '.join(t)}]" if show_types else n for n, t in topics.items()]
+    lines = ["Published topics:"]
+    lines += _verbose_section(session, topics, PUBLISHER, "publisher")
+    lines += ["", "Subscribed topics:"]
+    lines += _verbose_section(session, topics, SUBSCRIPTION, "subscriber")
+    return [*lines, ""]
+
+
+def _verbose_section(
+    session: Session, topics: dict[str, list[str]], kind: str, word: str
+) -> list[str]:
+    lines = []
+    for name, types in topics.items():
+        n = session.graph().count(kind, name)
+        if n:
+            lines.append(f" * {name} [{', '.join(types)}] {n} {word}{'s' if n > 1 else ''}")
+    return lines
+
+
+def find_topics(session: Session, type_name: str, *, include_hidden: bool = False) -> list[str]:
+    """Topics carrying ``type_name`` (``pkg/msg/T`` or ``pkg/T``)."""
+    from rosl.idl.names import canonical
+
+    wanted = canonical(type_name)
+    return [
+        name
+        for name, types in session.graph().topics().items()
+        if wanted in types and visible(name, include_hidden)
+    ]
+
+
+def topic_info(session: Session, topic: str, *, verbose: bool = False) -> list[str]:
+    """The lines ``ros2 topic info [-v]`` prints, plus rosl's loss counters with ``-v``."""
+    types = session.topic_types(topic)
+    graph = session.graph()
+    end = "\n" if verbose else ""
+    type_text = types[0] if len(types) == 1 else str(types)
+    lines = [f"Type: {type_text}{end}"]
+    pubs = sorted_endpoints(graph.endpoints(PUBLISHER, topic))
+    subs = sorted_endpoints(graph.endpoints(SUBSCRIPTION, topic))
+    lines.append(f"Publisher count: {len(pubs)}{end}")
+    if verbose:
+        lines += [_endpoint_block(node, e) + "\n" for node, e in pubs]
+    lines.append(f"Subscription count: {len(subs)}{end}")
+    if verbose:
+        lines += [_endpoint_block(node, e) + "\n" for node, e in subs]
+    return lines
+
+
+def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord) -> str:
+    qos = endpoint.qos
+    history = qos.get("history", "KEEP_LAST")
+    depth = f"{history} ({qos.get('depth', 0)})" if history == "KEEP_LAST" else history
+    lines = [
+        f"Node name: {node.name}",
+        f"Node namespace: {node.namespace}",
+        f"Topic type: {endpoint.type}",
+        f"Endpoint type: {endpoint.kind.upper()}",
+        f"GID: {gid(node.process, endpoint.endpoint)}",
+        "QoS profile:",
+        f"  Reliability: {qos.get('reliability', 'UNKNOWN')}",
+        f"  History (Depth): {depth}",
+        f"  Durability: {qos.get('durability', 'UNKNOWN')}",
+        "  Lifespan: Infinite",
+        "  Deadline: Infinite",
+        f"  Liveliness: {qos.get('liveliness', 'AUTOMATIC')}",
+        "  Liveliness lease duration: Infinite",
+    ]
+    stats = endpoint.stats
+    if endpoint.kind == PUBLISHER:
+        lines.append(f"Messages sent: {stats.get('sent', 0)}")
+    else:
+        lines.append(
+            f"Messages received: {stats.get('received', 0)} "
+            f"(lost: {stats.get('lost', 0)}, wrong type: {stats.get('mismatched', 0)})"
+        )
+    return "\n".join(lines)

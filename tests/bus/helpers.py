@@ -1,0 +1,146 @@
+"""Helpers for the bus tests: a second locked domain, a socket collector, child output lines."""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import queue
+import random
+import select
+import threading
+import time
+from typing import TYPE_CHECKING
+
+from tests.conftest import LOCK_DIR
+
+if TYPE_CHECKING:
+    import socket
+    import subprocess
+    from collections.abc import Callable, Iterator
+
+    from rosl.bus.wire import Delivery, Reader
+
+
+@contextlib.contextmanager
+def another_domain(*exclude: int) -> Iterator[int]:
+    """Lock one more domain id the way the ``domain_id`` fixture does (for isolation tests)."""
+    LOCK_DIR.mkdir(exist_ok=True)
+    candidates = [d for d in range(20, 233) if d not in exclude]
+    random.shuffle(candidates)
+    for domain in candidates:
+        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held while in use
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        try:
+            yield domain
+        finally:
+            handle.close()
+        return
+    raise RuntimeError("no second free test domain id")
+
+
+class Collector:
+    """Drains one socket with a Reader on a background thread into ``deliveries``."""
+
+    def __init__(self, reader: Reader, sock: socket.socket) -> None:
+        self.reader = reader
+        self.sock = sock
+        self.deliveries: list[Delivery] = []
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        batch: list[Delivery] = []
+        while not self._stop.is_set():
+            ready, _, _ = select.select([self.sock], [], [], 0.02)
+            if not ready:
+                continue
+            while self.reader.drain(self.sock, batch):
+                pass
+            with self._lock:
+                self.deliveries.extend(batch)
+            batch.clear()
+
+    def snapshot(self) -> list[Delivery]:
+        with self._lock:
+            return list(self.deliveries)
+
+    def wait_for(self, predicate: Callable[[list[Delivery]], bool], timeout: float = 5.0) -> bool:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if predicate(self.snapshot()):
+                return True
+            time.sleep(0.01)
+        return predicate(self.snapshot())
+
+    def wait_count(self, count: int, timeout: float = 5.0) -> list[Delivery]:
+        self.wait_for(lambda got: len(got) >= count, timeout)
+        return self.snapshot()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+
+
+class Lines:
+    """Reads a child's stdout (or stderr) line by line on a thread; waits are bounded."""
+
+    def __init__(self, stream: object) -> None:
+        self.lines: list[str] = []
+        self._queue: queue.Queue[str | None] = queue.Queue()
+        self._thread = threading.Thread(target=self._run, args=(stream,), daemon=True)
+        self._thread.start()
+        self.closed = False
+
+    def _run(self, stream: object) -> None:
+        for line in stream:  # type: ignore[attr-defined]
+            self._queue.put(line.rstrip("\n"))
+        self._queue.put(None)
+
+    def _pull(self, timeout: float) -> bool:
+        try:
+            line = self._queue.get(timeout=max(0.0, timeout))
+        except queue.Empty:
+            return False
+        if line is None:
+            self.closed = True
+            return False
+        self.lines.append(line)
+        return True
+
+    def wait_for(self, predicate: Callable[[list[str]], bool], timeout: float) -> bool:
+        """Wait until ``predicate(lines so far)`` holds, the stream ends, or the timeout."""
+        deadline = time.monotonic() + timeout
+        while not predicate(self.lines):
+            if self.closed:
+                return False
+            if not self._pull(deadline - time.monotonic()) and time.monotonic() >= deadline:
+                return predicate(self.lines)
+        return True
+
+    def wait_line(self, prefix: str, timeout: float) -> str | None:
+        """The first line starting with ``prefix`` (waiting for it up to ``timeout``)."""
+        if self.wait_for(lambda lines: any(x.startswith(prefix) for x in lines), timeout):
+            return next(x for x in self.lines if x.startswith(prefix))
+        return None
+
+    def rest(self, timeout: float = 5.0) -> list[str]:
+        """Every line, after waiting (bounded) for the stream to end."""
+        self.wait_for(lambda _: False, timeout)
+        return self.lines
+
+
+def wait_exit(child: subprocess.Popen[str], timeout: float) -> int | None:
+    """The child's exit code, or None if it is still running after ``timeout``."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        code = child.poll()
+        if code is not None:
+            return code
+        time.sleep(0.02)
+    return child.poll()

@@ -1,0 +1,402 @@
+"""Parameters: declaration, overrides from the command line and files, typed updates,
+callbacks, descriptors, atomic sets, the rcl_interfaces services and /parameter_events."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.node.helpers import spin_until
+
+WRONG_TYPE = (
+    "Wrong parameter type, parameter {{{name}}} is of type {{{declared}}}, "
+    "setting it to {{{given}}} is not allowed."
+)
+
+
+def test_a_declared_parameter_has_its_default_when_nothing_overrides_it(ros):
+    node = ros.Node("defaults")
+    param = node.declare_parameter("rate", 2.5)
+    assert param.value == 2.5
+    assert node.get_parameter("rate").value == 2.5
+    assert node.get_parameter("rate").as_double() == 2.5
+    assert node.get_parameter("rate").type_ is ros.Parameter.Type.DOUBLE
+    assert node.has_parameter("rate")
+    assert not node.has_parameter("other")
+
+
+def test_ros_args_p_overrides_are_read_as_yaml_typed_values(ros):
+    node = ros.Node(
+        "typed",
+        cli_args=[
+            "--ros-args",
+            "-p", "ratio:=1.5",
+            "-p", "count:=3",
+            "-p", "enabled:=true",
+            "-p", "ids:=[1,2]",
+            "-p", "greeting:=hello world",
+            "-p", "rate:=3",
+            "-p", "other_node:count:=99",
+        ],
+    )  # fmt: skip
+    ratio = node.declare_parameter("ratio", 0.0)
+    count = node.declare_parameter("count", 0)
+    enabled = node.declare_parameter("enabled", False)
+    ids = node.declare_parameter("ids", [0])
+    greeting = node.declare_parameter("greeting", "hi")
+    rate = node.declare_parameter("rate", 1.0)
+
+    assert (ratio.value, ratio.type_) == (1.5, ros.Parameter.Type.DOUBLE)
+    assert (count.value, count.type_) == (3, ros.Parameter.Type.INTEGER)
+    assert (enabled.value, enabled.type_) == (True, ros.Parameter.Type.BOOL)
+    assert (ids.value, ids.type_) == ([1, 2], ros.Parameter.Type.INTEGER_ARRAY)
+    assert (greeting.value, greeting.type_) == ("hello world", ros.Parameter.Type.STRING)
+    # an int given for a double parameter becomes a double
+    assert rate.type_ is ros.Parameter.Type.DOUBLE
+    assert isinstance(rate.value, float)
+    assert rate.value == 3.0
+    assert node.get_parameter("rate").as_double() == 3.0
+
+
+def test_global_ros_args_reach_nodes_of_the_process(spawn):
+    child = spawn(
+        """
+        import rosl
+        rosl.init()
+        node = rosl.Node("cli_node")
+        print("gain", repr(node.declare_parameter("gain", 0.5).value), flush=True)
+        print("name", repr(node.declare_parameter("label", "x").value), flush=True)
+        rosl.shutdown()
+        """,
+        "--ros-args", "-p", "gain:=4", "-p", "label:=front camera",
+    )  # fmt: skip
+    child.expect("^gain 4.0$")
+    child.expect("^name 'front camera'$")
+
+
+def test_a_params_file_applies_wildcards_then_the_node_section(ros, tmp_path):
+    params = tmp_path / "params.yaml"
+    params.write_text(
+        "file_node:\n"
+        "  ros__parameters:\n"
+        "    who: specific\n"
+        "    nested:\n"
+        "      gain: 2\n"
+        "/**:\n"
+        "  ros__parameters:\n"
+        "    who: wildcard\n"
+        "    shared: 7\n"
+        "    speed: 1\n"
+        "someone_else:\n"
+        "  ros__parameters:\n"
+        "    shared: 1000\n"
+    )
+    node = ros.Node("file_node", cli_args=["--ros-args", "--params-file", str(params)])
+
+    assert node.declare_parameter("who", "default").value == "specific"
+    assert node.declare_parameter("shared", 0).value == 7
+    assert node.declare_parameter("nested.gain", 0).value == 2
+    speed = node.declare_parameter("speed", 0.5)
+    assert speed.type_ is ros.Parameter.Type.DOUBLE
+    assert speed.value == 1.0
+
+
+def test_command_line_p_wins_over_a_params_file(ros, tmp_path):
+    params = tmp_path / "params.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    level: 1\n")
+    node = ros.Node(
+        "both", cli_args=["--ros-args", "--params-file", str(params), "-p", "level:=2"]
+    )
+    assert node.declare_parameter("level", 0).value == 2
+
+
+def test_a_malformed_params_file_is_a_clear_error(ros, tmp_path):
+    from rosl.node.errors import RosArgsError
+
+    params = tmp_path / "bad.yaml"
+    params.write_text("file_node:\n  speed: 1\n")
+    with pytest.raises(RosArgsError, match="ros__parameters"):
+        ros.Node("file_node", cli_args=["--ros-args", "--params-file", str(params)])
+
+
+def test_setting_a_parameter_to_another_type_is_refused_with_ros2s_text(ros):
+    node = ros.Node("strict")
+    node.declare_parameter("speed", 1.5)
+
+    [result] = node.set_parameters([ros.Parameter("speed", value="fast")])
+
+    assert not result.successful
+    assert result.reason == WRONG_TYPE.format(name="speed", declared="double", given="string")
+    assert node.get_parameter("speed").value == 1.5
+    # an int for a double is accepted and stored as a double
+    [ok] = node.set_parameters([ros.Parameter("speed", value=4)])
+    assert ok.successful
+    assert node.get_parameter("speed").value == 4.0
+    assert node.get_parameter("speed").type_ is ros.Parameter.Type.DOUBLE
+
+
+def test_reading_a_parameter_as_the_wrong_type_or_undeclared_raises(ros):
+    from rosl.node.errors import InvalidParameterTypeException, ParameterNotDeclaredException
+
+    node = ros.Node("reader")
+    node.declare_parameter("name", "bob")
+    with pytest.raises(InvalidParameterTypeException, match="string"):
+        node.get_parameter("name").as_double()
+    with pytest.raises(ParameterNotDeclaredException, match="missing"):
+        node.get_parameter("missing")
+    [result] = node.set_parameters([ros.Parameter("missing", value=1)])
+    assert not result.successful
+    assert "missing" in result.reason
+
+
+def test_an_on_set_callback_can_refuse_a_change_with_a_reason(ros):
+    from rcl_interfaces.msg import SetParametersResult
+
+    node = ros.Node("guarded")
+    node.declare_parameter("speed", 1.0)
+    seen: list[list[str]] = []
+
+    def check(params):
+        seen.append([p.name for p in params])
+        for p in params:
+            if p.name == "speed" and p.value > 10.0:
+                return SetParametersResult(successful=False, reason="speed must be <= 10")
+        return SetParametersResult(successful=True)
+
+    node.add_on_set_parameters_callback(check)
+    [refused] = node.set_parameters([ros.Parameter("speed", value=20.0)])
+    [accepted] = node.set_parameters([ros.Parameter("speed", value=5.0)])
+
+    assert (refused.successful, refused.reason) == (False, "speed must be <= 10")
+    assert accepted.successful
+    assert node.get_parameter("speed").value == 5.0
+    assert seen == [["speed"], ["speed"]]
+    node.remove_on_set_parameters_callback(check)
+    assert node.set_parameters([ros.Parameter("speed", value=20.0)])[0].successful
+
+
+def test_a_read_only_parameter_cannot_be_set(ros):
+    from rcl_interfaces.msg import ParameterDescriptor
+
+    node = ros.Node("constant")
+    node.declare_parameter("serial", "A123", ParameterDescriptor(read_only=True))
+
+    [result] = node.set_parameters([ros.Parameter("serial", value="B456")])
+
+    assert not result.successful
+    assert "read-only" in result.reason
+    assert "serial" in result.reason
+    assert node.get_parameter("serial").value == "A123"
+    assert node.describe_parameter("serial").read_only is True
+
+
+def test_a_parameter_outside_its_descriptor_range_is_refused(ros):
+    from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
+
+    node = ros.Node("ranged")
+    descriptor = ParameterDescriptor(
+        floating_point_range=[FloatingPointRange(from_value=0.0, to_value=1.0, step=0.0)]
+    )
+    node.declare_parameter("alpha", 0.5, descriptor)
+    [result] = node.set_parameters([ros.Parameter("alpha", value=1.5)])
+    assert not result.successful
+    assert "alpha" in result.reason
+    assert node.get_parameter("alpha").value == 0.5
+
+
+def test_set_parameters_atomically_changes_all_or_nothing(ros):
+    node = ros.Node("atomic")
+    node.declare_parameter("a", 1)
+    node.declare_parameter("b", 2.0)
+
+    refused = node.set_parameters_atomically(
+        [ros.Parameter("a", value=10), ros.Parameter("b", value="not a double")]
+    )
+    assert not refused.successful
+    assert refused.reason == WRONG_TYPE.format(name="b", declared="double", given="string")
+    assert node.get_parameter("a").value == 1
+    assert node.get_parameter("b").value == 2.0
+
+    accepted = node.set_parameters_atomically(
+        [ros.Parameter("a", value=10), ros.Parameter("b", value=20.0)]
+    )
+    assert accepted.successful
+    assert (node.get_parameter("a").value, node.get_parameter("b").value) == (10, 20.0)
+
+
+def test_declaring_twice_is_an_error(ros):
+    from rosl.node.errors import ParameterAlreadyDeclaredException
+
+    node = ros.Node("twice")
+    node.declare_parameter("x", 1)
+    with pytest.raises(ParameterAlreadyDeclaredException, match="'x'"):
+        node.declare_parameter("x", 2)
+
+
+REMOTE = """
+import rosl
+from rcl_interfaces.msg import ParameterDescriptor
+
+rosl.init()
+node = rosl.Node("remote_params")
+node.declare_parameter("gain", 1.5, ParameterDescriptor(description="how strong"))
+node.declare_parameter("mode", "auto")
+node.declare_parameter("limits.low", 1)
+node.declare_parameter("limits.high", 9)
+node.declare_parameter("fixed", 3, ParameterDescriptor(read_only=True))
+last = {}
+
+def report():
+    value = node.get_parameter("gain").value
+    if last.get("gain") != value:
+        last["gain"] = value
+        print("gain is", value, flush=True)
+
+node.create_timer(0.05, report)
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def _value(msg):
+    from rosl.node.parameters import value_from_msg
+
+    return value_from_msg(msg)[1]
+
+
+def test_another_process_reads_and_changes_parameters_through_the_services(ros, spawn):
+    from rcl_interfaces.msg import Parameter as ParameterMsg
+    from rcl_interfaces.msg import ParameterType, ParameterValue
+    from rcl_interfaces.srv import (
+        DescribeParameters,
+        GetParameters,
+        GetParameterTypes,
+        ListParameters,
+        SetParameters,
+    )
+
+    child = spawn(REMOTE)
+    child.expect("^ready$")
+    child.expect("^gain is 1.5$")
+    node = ros.Node("param_tool")
+
+    def client(srv, name):
+        c = node.create_client(srv, f"/remote_params/{name}")
+        assert c.wait_for_service(timeout_sec=8.0), name
+        return c
+
+    got = client(GetParameters, "get_parameters").call(
+        GetParameters.Request(names=["gain", "mode", "nope"]), timeout_sec=5.0
+    )
+    assert [_value(v) for v in got.values] == [1.5, "auto", None]
+
+    types = client(GetParameterTypes, "get_parameter_types").call(
+        GetParameterTypes.Request(names=["gain", "mode", "limits.low"]), timeout_sec=5.0
+    )
+    assert list(types.types) == [
+        ParameterType.PARAMETER_DOUBLE,
+        ParameterType.PARAMETER_STRING,
+        ParameterType.PARAMETER_INTEGER,
+    ]
+
+    listed = client(ListParameters, "list_parameters").call(
+        ListParameters.Request(), timeout_sec=5.0
+    )
+    assert {"gain", "mode", "limits.low", "limits.high", "fixed", "use_sim_time"} <= set(
+        listed.result.names
+    )
+    assert "limits" in listed.result.prefixes
+    only_limits = client(ListParameters, "list_parameters").call(
+        ListParameters.Request(prefixes=["limits"]), timeout_sec=5.0
+    )
+    assert sorted(only_limits.result.names) == ["limits.high", "limits.low"]
+
+    described = client(DescribeParameters, "describe_parameters").call(
+        DescribeParameters.Request(names=["gain", "fixed"]), timeout_sec=5.0
+    )
+    assert [(d.name, d.type, d.description, d.read_only) for d in described.descriptors] == [
+        ("gain", ParameterType.PARAMETER_DOUBLE, "how strong", False),
+        ("fixed", ParameterType.PARAMETER_INTEGER, "", True),
+    ]
+
+    setter = client(SetParameters, "set_parameters")
+    request = SetParameters.Request(
+        parameters=[
+            ParameterMsg(
+                name="gain",
+                value=ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=2.5),
+            ),
+            ParameterMsg(
+                name="mode",
+                value=ParameterValue(type=ParameterType.PARAMETER_INTEGER, integer_value=3),
+            ),
+            ParameterMsg(
+                name="fixed",
+                value=ParameterValue(type=ParameterType.PARAMETER_INTEGER, integer_value=4),
+            ),
+        ]
+    )
+    results = setter.call(request, timeout_sec=5.0).results
+    assert [r.successful for r in results] == [True, False, False]
+    assert results[1].reason == WRONG_TYPE.format(name="mode", declared="string", given="integer")
+    assert "read-only" in results[2].reason
+    child.expect("^gain is 2.5$")
+    again = client(GetParameters, "get_parameters").call(
+        GetParameters.Request(names=["gain", "mode", "fixed"]), timeout_sec=5.0
+    )
+    assert [_value(v) for v in again.values] == [2.5, "auto", 3]
+
+
+def test_parameter_changes_are_published_on_parameter_events(ros, spawn):
+    from rcl_interfaces.msg import ParameterEvent
+    from rcl_interfaces.srv import SetParameters
+
+    child = spawn(REMOTE)
+    child.expect("^ready$")
+    node = ros.Node("event_watcher")
+    events: list[ParameterEvent] = []
+    node.create_subscription(ParameterEvent, "/parameter_events", events.append, 10)
+    setter = node.create_client(SetParameters, "/remote_params/set_parameters")
+    assert setter.wait_for_service(timeout_sec=8.0)
+
+    request = SetParameters.Request(parameters=[ros.Parameter("gain", value=7.25).to_parameter_msg()])
+    assert setter.call(request, timeout_sec=5.0).results[0].successful
+
+    def changed_gain():
+        return [
+            e
+            for e in events
+            if e.node == "/remote_params" and any(p.name == "gain" for p in e.changed_parameters)
+        ]
+
+    assert spin_until(node, lambda: bool(changed_gain()), 5.0), [e.node for e in events]
+    event = changed_gain()[0]
+    [param] = [p for p in event.changed_parameters if p.name == "gain"]
+    assert _value(param.value) == 7.25
+    assert list(event.new_parameters) == []
+    assert list(event.deleted_parameters) == []
+
+
+def test_the_nodes_own_declarations_and_sets_are_published_on_parameter_events(ros):
+    from rcl_interfaces.msg import ParameterEvent
+
+    watcher = ros.Node("own_watcher")
+    events: list[ParameterEvent] = []
+    watcher.create_subscription(ParameterEvent, "/parameter_events", events.append, 10)
+    node = ros.Node("own_events", namespace="/lab")
+    spin_until(watcher, lambda: False, 0.2)  # let the subscription settle
+
+    node.declare_parameter("threshold", 0.25)
+    node.set_parameters([ros.Parameter("threshold", value=0.75)])
+
+    def mine():
+        return [e for e in events if e.node == "/lab/own_events"]
+
+    assert spin_until(
+        watcher,
+        lambda: any(p.name == "threshold" for e in mine() for p in e.changed_parameters),
+        5.0,
+    )
+    new = [p for e in mine() for p in e.new_parameters if p.name == "threshold"]
+    changed = [p for e in mine() for p in e.changed_parameters if p.name == "threshold"]
+    assert [_value(p.value) for p in new] == [0.25]
+    assert [_value(p.value) for p in changed] == [0.75]

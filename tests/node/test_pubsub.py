@@ -1,0 +1,246 @@
+"""Publishers and subscriptions across processes, and the QoS words that change behaviour."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from tests.node.helpers import spin_for, spin_until
+
+ECHO = """
+import rosl
+from std_msgs.msg import String
+
+rosl.init()
+node = rosl.Node("echo")
+back = node.create_publisher(String, "pong", 10)
+
+def on_ping(msg):
+    print("heard:", msg.data, flush=True)
+    back.publish(String(data="echo " + msg.data))
+
+node.create_subscription(String, "ping", on_ping, 10)
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def test_a_string_crosses_to_another_process_and_its_echo_comes_back(ros, spawn):
+    from std_msgs.msg import String
+
+    child = spawn(ECHO)
+    child.expect("^ready$")
+    node = ros.Node("pinger")
+    pub = node.create_publisher(String, "ping", 10)
+    replies: list[str] = []
+    node.create_subscription(String, "pong", lambda m: replies.append(m.data), 10)
+    text = "hello wörld ✓ 123"
+
+    assert spin_until(node, lambda: bool(replies), 8.0, each=lambda: pub.publish(String(data=text)))
+    assert replies[0] == f"echo {text}"
+    child.expect(f"^heard: {text}$")
+
+
+LASER = """
+import math
+import rosl
+from sensor_msgs.msg import LaserScan
+from geometry_msgs.msg import Twist
+
+rosl.init()
+node = rosl.Node("sensors")
+scan_pub = node.create_publisher(LaserScan, "scan", 10)
+twist_pub = node.create_publisher(Twist, "cmd_vel", 10)
+scan = LaserScan()
+scan.header.frame_id = "laser_frame"
+scan.header.stamp.sec = 12
+scan.header.stamp.nanosec = 345
+scan.angle_min = -1.5
+scan.angle_max = 1.5
+scan.angle_increment = 0.25
+scan.range_min = 0.125
+scan.range_max = 30.0
+scan.ranges = [0.5, 1.25, 2.0, 3.75, 10.5, 0.0, 29.875]
+scan.intensities = [1.0, 2.0, 4.0]
+twist = Twist()
+twist.linear.x = 1.5
+twist.linear.y = -0.25
+twist.angular.z = -0.75
+
+def tick():
+    scan_pub.publish(scan)
+    twist_pub.publish(twist)
+
+node.create_timer(0.05, tick)
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def test_a_laser_scan_with_arrays_and_a_nested_twist_arrive_with_equal_values(ros, spawn):
+    from geometry_msgs.msg import Twist
+    from sensor_msgs.msg import LaserScan
+
+    child = spawn(LASER)
+    child.expect("^ready$")
+    node = ros.Node("listener")
+    scans: list[LaserScan] = []
+    twists: list[Twist] = []
+    node.create_subscription(LaserScan, "scan", scans.append, 10)
+    node.create_subscription(Twist, "/cmd_vel", twists.append, 10)
+
+    assert spin_until(node, lambda: bool(scans) and bool(twists), 8.0)
+    scan = scans[0]
+    assert scan.header.frame_id == "laser_frame"
+    assert (scan.header.stamp.sec, scan.header.stamp.nanosec) == (12, 345)
+    assert (scan.angle_min, scan.angle_max, scan.angle_increment) == (-1.5, 1.5, 0.25)
+    assert (scan.range_min, scan.range_max) == (0.125, 30.0)
+    assert [float(r) for r in scan.ranges] == [0.5, 1.25, 2.0, 3.75, 10.5, 0.0, 29.875]
+    assert [float(i) for i in scan.intensities] == [1.0, 2.0, 4.0]
+    twist = twists[0]
+    assert (twist.linear.x, twist.linear.y, twist.linear.z) == (1.5, -0.25, 0.0)
+    assert (twist.angular.x, twist.angular.y, twist.angular.z) == (0.0, 0.0, -0.75)
+    expected = Twist()
+    expected.linear.x, expected.linear.y, expected.angular.z = 1.5, -0.25, -0.75
+    assert twist == expected
+
+
+def test_a_node_receives_its_own_messages_on_a_topic_it_publishes(ros):
+    from std_msgs.msg import Int32
+
+    node = ros.Node("self_talker")
+    pub = node.create_publisher(Int32, "loop", 10)
+    got: list[int] = []
+    node.create_subscription(Int32, "loop", lambda m: got.append(m.data), 10)
+
+    assert spin_until(node, lambda: bool(got), 5.0, each=lambda: pub.publish(Int32(data=41)))
+    assert set(got) == {41}
+
+
+def test_a_message_sent_as_bytes_is_received_as_the_message(ros):
+    from std_msgs.msg import String
+
+    from rosl.idl import registry
+
+    node = ros.Node("raw_sender")
+    pub = node.create_publisher(String, "raw", 10)
+    got: list[str] = []
+    node.create_subscription(String, "raw", lambda m: got.append(m.data), 10)
+    data = registry.store().serialize(String(data="pre-serialized"))
+
+    assert spin_until(node, lambda: bool(got), 5.0, each=lambda: pub.publish(data))
+    assert got[0] == "pre-serialized"
+
+
+# --- QoS -------------------------------------------------------------------------------------
+
+LATCHED = """
+import time
+import rosl
+from std_msgs.msg import Int32
+from rosl.node.qos import DurabilityPolicy, QoSProfile
+
+rosl.init()
+node = rosl.Node("latcher")
+qos = QoSProfile(depth=3, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+pub = node.create_publisher(Int32, "latched", qos)
+for i in range(1, 6):
+    pub.publish(Int32(data=i))
+print("published", flush=True)
+seen = []
+
+def tick():
+    # once a subscriber shows up, go on with live messages (6) after a short pause
+    if pub.get_subscription_count() > 0:
+        seen.append(time.monotonic())
+        if time.monotonic() - seen[0] > 0.5:
+            pub.publish(Int32(data=6))
+
+node.create_timer(0.1, tick)
+rosl.spin(node)
+"""
+
+
+def _late_subscriber(ros, spawn, durability):
+    from std_msgs.msg import Int32
+
+    from rosl.node.qos import QoSProfile
+
+    child = spawn(LATCHED)
+    child.expect("^published$")
+    node = ros.Node("late_listener")
+    got: list[int] = []
+    qos = QoSProfile(depth=10, durability=durability)
+    node.create_subscription(Int32, "latched", lambda m: got.append(m.data), qos)
+    # wait for the live message 6 (sent ~0.5 s after the subscription is seen), then a bit more
+    assert spin_until(node, lambda: 6 in got, 8.0), f"no live message arrived: {got}"
+    spin_for(node, 0.2)
+    return got
+
+
+def test_a_late_transient_local_subscriber_gets_the_last_depth_messages_in_order(ros, spawn):
+    from rosl.node.qos import DurabilityPolicy
+
+    got = _late_subscriber(ros, spawn, DurabilityPolicy.TRANSIENT_LOCAL)
+    assert got[:3] == [3, 4, 5], got
+    assert set(got[3:]) == {6}, got
+
+
+def test_a_late_volatile_subscriber_gets_none_of_the_old_messages(ros, spawn):
+    from rosl.node.qos import DurabilityPolicy
+
+    got = _late_subscriber(ros, spawn, DurabilityPolicy.VOLATILE)
+    assert got, "the subscription heard nothing at all"
+    assert set(got) == {6}, got
+
+
+def test_publishing_never_blocks_when_nobody_subscribes(ros):
+    from std_msgs.msg import String
+
+    from rosl.node.qos import (
+        DurabilityPolicy,
+        QoSProfile,
+        ReliabilityPolicy,
+        qos_profile_sensor_data,
+    )
+
+    node = ros.Node("lonely")
+    publishers = [
+        node.create_publisher(String, "nobody_reliable", QoSProfile(depth=1)),
+        node.create_publisher(
+            String,
+            "nobody_latched",
+            QoSProfile(
+                depth=3,
+                reliability=ReliabilityPolicy.RELIABLE,
+                durability=DurabilityPolicy.TRANSIENT_LOCAL,
+            ),
+        ),
+        node.create_publisher(String, "nobody_sensor", qos_profile_sensor_data),
+    ]
+    sent = [0]
+
+    def publish_many() -> None:
+        for i in range(500):
+            for pub in publishers:
+                pub.publish(String(data=f"message {i}" * 20))
+                sent[0] += 1
+
+    worker = threading.Thread(target=publish_many, daemon=True)
+    worker.start()
+    worker.join(timeout=20)
+    assert not worker.is_alive(), f"publish blocked after {sent[0]} messages"
+    assert sent[0] == 1500
+    assert all(p.get_subscription_count() == 0 for p in publishers)
+
+
+def test_publishing_a_message_of_the_wrong_type_names_both_types(ros):
+    from std_msgs.msg import Int32, String
+
+    node = ros.Node("typo")
+    pub = node.create_publisher(String, "typed", 10)
+    with pytest.raises(TypeError) as err:
+        pub.publish(Int32(data=1))
+    assert "std_msgs/msg/String" in str(err.value)
+    assert "std_msgs/msg/Int32" in str(err.value)
