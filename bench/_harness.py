@@ -9,7 +9,10 @@ import struct
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 IP_MULTICAST_ALL = 49
 BENCH_DOMAIN = int(os.environ.get("ROSL_BENCH_DOMAIN", "199"))

@@ -15,7 +15,7 @@ import selectors
 import sys
 import time
 
-from _harness import BENCH_DOMAIN, finish, median_of, raw_receiver, raw_sender, spawn
+from _harness import BENCH_DOMAIN, finish, raw_receiver, raw_sender, spawn
 
 SIZES = [64, 1024, 60000, 1048576]
 GROUP, PORT = f"239.255.{BENCH_DOMAIN}.9", 17400 + BENCH_DOMAIN + 1  # a port rosl does not use
@@ -98,7 +98,7 @@ def pub_bus(count: int, size: int) -> None:
 def measure(kind: str, count: int, size: int) -> tuple[float, float]:
     child = spawn([__file__, f"sub_{kind}", str(count), str(size)])
     globals()[f"pub_{kind}"](count, size)
-    got, seconds, lost = finish(child).split()
+    got, seconds, _lost = finish(child).split()
     got_n, secs = int(got), float(seconds)
     rate = got_n / secs if secs > 0 else 0.0
     return rate, 100.0 * (count - got_n) / count
@@ -109,8 +109,10 @@ def main() -> None:
     parser.add_argument("--count", type=int, default=40000)
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()
-    print(f"{'size':>8} {'raw msg/s':>10} {'raw MB/s':>9} {'bus msg/s':>10} {'bus MB/s':>9} "
-          f"{'ratio':>6} {'loss %':>7}")
+    print(
+        f"{'size':>8} {'raw msg/s':>10} {'raw MB/s':>9} {'bus msg/s':>10} {'bus MB/s':>9} "
+        f"{'ratio':>6} {'loss %':>7}"
+    )
     raw60 = 0.0
     for size in SIZES:
         count = max(200, min(args.count, int(4e9 / max(size, 1) / 10)))
@@ -124,8 +126,11 @@ def main() -> None:
         bus_rate, loss = sorted(results)[len(results) // 2]
         base = raw_rate * size / 1e6 if raw_rate else raw60
         ratio = bus_rate * size / 1e6 / base if base else 0.0
-        print(f"{size:>8} {raw_rate:>10.0f} {raw_rate * size / 1e6:>9.1f} {bus_rate:>10.0f} "
-              f"{bus_rate * size / 1e6:>9.1f} {ratio:>6.2f} {loss:>7.2f}", flush=True)
+        print(
+            f"{size:>8} {raw_rate:>10.0f} {raw_rate * size / 1e6:>9.1f} {bus_rate:>10.0f} "
+            f"{bus_rate * size / 1e6:>9.1f} {ratio:>6.2f} {loss:>7.2f}",
+            flush=True,
+        )
     print("ratio = rosl MB/s / raw MB/s at the same size (1 MiB: / raw 60 KB MB/s)")
 
 

@@ -56,7 +56,8 @@ def main() -> None:
         for index in range(args.nodes):
             child = subprocess.Popen(
                 [sys.executable, "-c", NODE.format(domain=BENCH_DOMAIN), str(index)],
-                stdout=subprocess.PIPE, text=True,
+                stdout=subprocess.PIPE,
+                text=True,
             )
             children.append(child)
         for child in children:
@@ -71,9 +72,13 @@ def main() -> None:
         print(f"graph: {args.nodes} nodes in {args.nodes} processes; medians of {args.runs} runs")
         print(f"python -c pass               {base * 1000:7.1f} ms")
         print(f"import rosl                  {imp * 1000:7.1f} ms")
-        print(f"new process sees the graph   {query * 1000:7.1f} ms  (nodes seen: {min(seen)}..{max(seen)})")
-        print(f"discovery over interpreter   {(query - base) * 1000:7.1f} ms  "
-              f"(ratio to interpreter start-up {query / base:.1f}x)")
+        print(
+            f"new process sees the graph   {query * 1000:7.1f} ms  (nodes seen: {min(seen)}..{max(seen)})"
+        )
+        print(
+            f"discovery over interpreter   {(query - base) * 1000:7.1f} ms  "
+            f"(ratio to interpreter start-up {query / base:.1f}x)"
+        )
     finally:
         for child in children:
             child.terminate()

@@ -54,8 +54,9 @@ def raw_ping(rounds: int, size: int) -> list[float]:
 
 
 def rosl_pong() -> None:
-    import rosl
     from std_msgs.msg import UInt8MultiArray
+
+    import rosl
 
     rosl.init([], domain_id=BENCH_DOMAIN)
     node = rosl.Node("pong")
@@ -67,14 +68,17 @@ def rosl_pong() -> None:
 
 
 def rosl_ping(rounds: int, size: int) -> list[float]:
-    import rosl
     from std_msgs.msg import UInt8MultiArray
+
+    import rosl
 
     rosl.init([], domain_id=BENCH_DOMAIN)
     node = rosl.Node("ping")
     pub = node.create_publisher(UInt8MultiArray, "/bench_ping", 10)
     got: list[float] = []
-    node.create_subscription(UInt8MultiArray, "/bench_pong", lambda m: got.append(time.perf_counter()), 10)
+    node.create_subscription(
+        UInt8MultiArray, "/bench_pong", lambda m: got.append(time.perf_counter()), 10
+    )
     executor = rosl.SingleThreadedExecutor()
     executor.add_node(node)
     msg = UInt8MultiArray(data=bytes(max(0, size - 16)))
@@ -116,8 +120,10 @@ def main() -> None:
     print(f"{'':8} {'median us':>10} {'p99 us':>8}")
     print(f"{'raw':8} {raw[0]:>10.1f} {raw[1]:>8.1f}")
     print(f"{'rosl':8} {ours[0]:>10.1f} {ours[1]:>8.1f}")
-    print(f"ratio rosl/raw: median {ours[0] / raw[0]:.2f} (target <= 1.5), "
-          f"p99 {ours[1] / raw[1]:.2f} (target <= 2.0)")
+    print(
+        f"ratio rosl/raw: median {ours[0] / raw[0]:.2f} (target <= 1.5), "
+        f"p99 {ours[1] / raw[1]:.2f} (target <= 2.0)"
+    )
 
 
 if __name__ == "__main__":

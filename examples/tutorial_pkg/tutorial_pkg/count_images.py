@@ -1,6 +1,6 @@
 """The /count_images service: how many image files a folder holds.
 
-    rosl service call /count_images tutorial_pkg/srv/CountImages "{folder_path: '/tmp'}"
+rosl service call /count_images tutorial_pkg/srv/CountImages "{folder_path: '/tmp'}"
 """
 
 from pathlib import Path

@@ -12,7 +12,9 @@ class MySubscriber(Node):
         self.subscription = self.create_subscription(MyData, "my_data", self.on_data, 10)
 
     def on_data(self, msg):
-        self.get_logger().info(f"I heard: counter={msg.counter} value={msg.value:.3f} label='{msg.label}'")
+        self.get_logger().info(
+            f"I heard: counter={msg.counter} value={msg.value:.3f} label='{msg.label}'"
+        )
 
 
 def main(args=None):

@@ -1,7 +1,7 @@
 """A timer whose period is the parameter timer_period_s (default 2.0 s), changeable live:
 
-    rosl run tutorial_pkg timer_node --ros-args -p timer_period_s:=1.0
-    rosl param set /timer_node timer_period_s 0.5
+rosl run tutorial_pkg timer_node --ros-args -p timer_period_s:=1.0
+rosl param set /timer_node timer_period_s 0.5
 """
 
 import rclpy
@@ -28,7 +28,9 @@ class TimerNode(Node):
         for param in params:
             if param.name == "timer_period_s":
                 if param.value <= 0.0:
-                    return SetParametersResult(successful=False, reason="timer_period_s must be > 0")
+                    return SetParametersResult(
+                        successful=False, reason="timer_period_s must be > 0"
+                    )
                 self.timer.timer_period_ns = int(param.value * 1e9)
                 self.get_logger().info(f"Timer period changed to {param.value} s")
         return SetParametersResult(successful=True)
