@@ -72,9 +72,8 @@ def main() -> None:
         print(f"graph: {args.nodes} nodes in {args.nodes} processes; medians of {args.runs} runs")
         print(f"python -c pass               {base * 1000:7.1f} ms")
         print(f"import rosl                  {imp * 1000:7.1f} ms")
-        print(
-            f"new process sees the graph   {query * 1000:7.1f} ms  (nodes seen: {min(seen)}..{max(seen)})"
-        )
+        seen_text = f"{min(seen)}..{max(seen)}"
+        print(f"new process sees the graph   {query * 1000:7.1f} ms  (nodes seen: {seen_text})")
         print(
             f"discovery over interpreter   {(query - base) * 1000:7.1f} ms  "
             f"(ratio to interpreter start-up {query / base:.1f}x)"
