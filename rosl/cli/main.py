@@ -19,11 +19,14 @@ from rosl.errors import RoslError
 
 # name -> (module, one-line help); the module defines a click command named ``command``
 COMMANDS: dict[str, tuple[str, str]] = {
+    "doctor": ("rosl.cli.doctor", "Check the setup: multicast, domain, packages, graph"),
+    "graph": ("rosl.cli.graph", "The node/topic graph as DOT, Mermaid or text (rqt_graph)"),
     "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),
     "node": ("rosl.cli.node", "Various node related sub-commands"),
     "param": ("rosl.cli.param", "Various param related sub-commands"),
     "pkg": ("rosl.cli.pkg", "Various package related sub-commands"),
     "service": ("rosl.cli.service", "Various service related sub-commands"),
+    "tf": ("rosl.cli.tf", "TF frames: the tree (view_frames) and transforms (tf2_echo)"),
     "topic": ("rosl.cli.topic", "Various topic related sub-commands"),
 }
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}

@@ -105,3 +105,30 @@ def call(
             session, service_name, service_type, data, rate=rate, timeout=timeout
         ):
             render.text(block + "\n")
+
+
+@command.command("echo")
+@click.argument("service_name")
+@click.argument("service_type", required=False)
+@click.option("-l", "--truncate-length", type=int, default=128, help="Truncate strings and arrays")
+@click.option("-f", "--full-length", is_flag=True, help="Do not truncate")
+@click.option("--once", is_flag=True, help="Print the first event and exit")
+@domain_option
+def echo(
+    service_name: str,
+    service_type: str | None,
+    truncate_length: int,
+    full_length: bool,
+    once: bool,
+    domain_id: int | None,
+) -> None:
+    """Echo a service's requests and responses as service events (no setup needed)."""
+    with Session(domain_id) as session:
+        for block in services.echo(
+            session,
+            service_name,
+            service_type,
+            truncate_length=None if full_length else truncate_length,
+            once=once,
+        ):
+            render.text(block + "\n")

@@ -45,7 +45,7 @@ def interface_path(name: TypeName) -> Path:
     """Return the file defining ``name`` (which may not exist)."""
     base = name.name
     if name.kind == "srv":
-        base = base.removesuffix("_Request").removesuffix("_Response")
+        base = _service_base(base)
     package = search_path.find_package(name.package)
     return package.path / name.kind / f"{base}.{name.kind}"
 
@@ -66,6 +66,8 @@ def load_spec(type_name: str) -> MessageSpec | ServiceSpec:
     """
     name = parse_type_name(type_name)
     key = str(name)
+    if name.kind == "srv" and name.name.endswith("_Event"):
+        return _event_spec(name)
     if name.kind == "srv" and name.name.endswith(("_Request", "_Response")):
         service = load_spec(f"{name.package}/srv/{_service_base(name.name)}")
         assert isinstance(service, ServiceSpec)
@@ -91,7 +93,27 @@ def load_spec(type_name: str) -> MessageSpec | ServiceSpec:
 
 
 def _service_base(name: str) -> str:
-    return name.removesuffix("_Request").removesuffix("_Response")
+    return name.removesuffix("_Request").removesuffix("_Response").removesuffix("_Event")
+
+
+def _event_spec(name: TypeName) -> MessageSpec:
+    """ROS 2 (Jazzy) service introspection's ``<Service>_Event``: info, request, response."""
+    from rosl.idl.parser import ArrayKind, Field
+
+    base = _service_base(name.name)
+    service = load_spec(f"{name.package}/srv/{base}")
+    assert isinstance(service, ServiceSpec)
+    text = (
+        "service_msgs/ServiceEventInfo info\n"
+        f"{base}_Request[<=1] request\n{base}_Response[<=1] response\n"
+    )
+    prefix = f"{name.package}/srv/{base}"
+    fields = (
+        Field("info", FieldType("service_msgs/msg/ServiceEventInfo"), written="ServiceEventInfo"),
+        Field("request", FieldType(f"{prefix}_Request", ArrayKind.BOUNDED, 1), written="x"),
+        Field("response", FieldType(f"{prefix}_Response", ArrayKind.BOUNDED, 1), written="x"),
+    )
+    return MessageSpec(str(name), fields, (), service.path, text)
 
 
 def _missing_message(name: TypeName, path: Path) -> str:

@@ -107,3 +107,41 @@ def call(
         pause = 1.0 / rate - (time.monotonic() - started)
         if pause > 0:
             time.sleep(pause)
+
+
+def echo(
+    session: Session,
+    name: str,
+    type_name: str | None,
+    *,
+    truncate_length: int | None = 128,
+    once: bool = False,
+) -> Iterator[str]:
+    """Yield each request and response of a service as a ``<Service>_Event`` (YAML + ``---``).
+
+    Nothing has to be switched on in the nodes: service traffic is visible on the bus.
+    """
+    from rosl.bus.header import topic_hash
+    from rosl.idl.yaml_io import dump_yaml, message_to_ordered
+    from rosl.node.service_events import EVENT_NAMES, event_from_delivery
+
+    service_type = resolve_service_type(session, name, type_name)
+    participant = session.participant
+    events: list[Any] = []
+
+    class _Tap:
+        def deliver(self, delivery: Any) -> None:
+            event = event_from_delivery(delivery, service_type)
+            if event is not None:
+                events.append(event)
+
+    participant.listen(topic_hash(name), _Tap())
+    while not participant.closed:
+        participant.poll(0.1)
+        for event in events:
+            data = message_to_ordered(event, truncate_length=truncate_length)
+            data["info"]["event_type"] = EVENT_NAMES.get(data["info"]["event_type"], "UNKNOWN")
+            yield dump_yaml(data) + "---"
+            if once:
+                return
+        events.clear()
