@@ -12,8 +12,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import PUBLISHER
-from rosl.idl.messages import Message
-from rosl.idl.yaml_io import dump_yaml, message_to_csv, message_to_ordered, message_to_yaml
+from rosl.idl.base import Message
 from rosl.introspection.errors import IntrospectionError
 
 if TYPE_CHECKING:
@@ -88,6 +87,8 @@ def compile_filter(expr: str | None) -> Any:
 
 def render(value: Any, options: EchoOptions) -> str:
     """One message (or selected field) as echo prints it, ending with ``---``."""
+    from rosl.idl.yaml_io import dump_yaml, message_to_csv, message_to_yaml
+
     truncate = options.truncate_length
     if isinstance(value, Message):
         if options.csv:
@@ -106,6 +107,8 @@ def render(value: Any, options: EchoOptions) -> str:
 
 
 def _plain(value: Any, truncate: int | None) -> Any:
+    from rosl.idl.yaml_io import message_to_ordered
+
     if isinstance(value, Message):
         return message_to_ordered(value, truncate_length=truncate)
     return value
@@ -161,6 +164,8 @@ def echo(
             if check is not None and not eval(check, {"m": value}):
                 continue
             if options.include_info:
+                from rosl.idl.yaml_io import dump_yaml
+
                 yield dump_yaml(info).rstrip("\n") + "\n---"
             yield render(value, options)
             shown += 1

@@ -1,4 +1,4 @@
-"""rclpy's module-level functions: init, shutdown, ok, spin, spin_once, create_node, ..."""
+"""Running rosl in this process: init, ok, shutdown, spin (rclpy's module functions)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,407 @@
+"""``rosl tf``: the TF frame tree (view_frames, without Graphviz) and transforms (tf2_echo).
+
+Listens to ``/tf`` and ``/tf_static`` (the latter transient-local, so a late listener still gets
+the static transforms), keeps the latest transform per edge plus a short history of receive
+times for the rate, and composes transforms through the tree with a few lines of quaternion
+math (no numpy). Each edge remembers which publisher sent it, so the broadcaster shown is the
+node that really broadcast that edge.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from rosl.graph.records import PUBLISHER
+from rosl.introspection.errors import IntrospectionError
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+    from pathlib import Path
+
+    from rosl.introspection.session import Session
+
+TOPICS = ("/tf", "/tf_static")
+HISTORY = 100  # receive times kept per edge, for the rate
+Vector = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]  # x, y, z, w
+
+
+# --- transforms ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Transform:
+    """A rigid transform: rotate by ``rotation``, then move by ``translation``."""
+
+    translation: Vector = (0.0, 0.0, 0.0)
+    rotation: Quaternion = (0.0, 0.0, 0.0, 1.0)
+
+    def __mul__(self, other: Transform) -> Transform:
+        """``self`` then ``other`` (parent←a times a←b gives parent←b)."""
+        moved = _rotate(self.rotation, other.translation)
+        origin = tuple(a + b for a, b in zip(self.translation, moved, strict=True))
+        return Transform(origin, _qmul(self.rotation, other.rotation))  # type: ignore[arg-type]
+
+    def inverse(self) -> Transform:
+        """The transform going the other way."""
+        x, y, z, w = self.rotation
+        norm = x * x + y * y + z * z + w * w or 1.0
+        inverse: Quaternion = (-x / norm, -y / norm, -z / norm, w / norm)
+        back = _rotate(inverse, self.translation)
+        return Transform((-back[0], -back[1], -back[2]), inverse)
+
+    def rpy(self) -> Vector:
+        """Roll, pitch, yaw in radians (tf2's Matrix3x3::getRPY)."""
+        x, y, z, w = self.rotation
+        roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+        pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+        yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        return (roll, pitch, yaw)
+
+
+def _qmul(a: Quaternion, b: Quaternion) -> Quaternion:
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def _rotate(q: Quaternion, v: Vector) -> Vector:
+    x, y, z, w = q
+    norm = x * x + y * y + z * z + w * w or 1.0
+    rx, ry, rz, _ = _qmul(_qmul(q, (v[0], v[1], v[2], 0.0)), (-x, -y, -z, w))
+    return (rx / norm, ry / norm, rz / norm)
+
+
+# --- the buffer -------------------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class Edge:
+    """The latest transform parent→child, who sent it, and recent receive times (ns)."""
+
+    parent: str
+    child: str
+    static: bool
+    transform: Transform
+    stamp_ns: int
+    senders: set[tuple[int, int]] = field(default_factory=set)
+    received: deque[int] = field(default_factory=lambda: deque(maxlen=HISTORY))
+    oldest_stamp_ns: int = 0
+    broadcasters: tuple[str, ...] = ()
+
+    @property
+    def rate(self) -> float | None:
+        """Messages per second over the kept history (None with fewer than two)."""
+        if len(self.received) < 2 or self.received[-1] <= self.received[0]:
+            return None
+        return (len(self.received) - 1) * 1e9 / (self.received[-1] - self.received[0])
+
+
+class TfBuffer:
+    """Edges by child frame (a frame has one parent; the latest message wins)."""
+
+    def __init__(self) -> None:
+        self.edges: dict[str, Edge] = {}
+
+    def add(self, message: Any, static: bool, sender: tuple[int, int], received_ns: int) -> None:
+        """Store every transform of a ``tf2_msgs/msg/TFMessage``."""
+        for ts in message.transforms:
+            parent, child = ts.header.frame_id.lstrip("/"), ts.child_frame_id.lstrip("/")
+            t, r = ts.transform.translation, ts.transform.rotation
+            stamp = ts.header.stamp.sec * 1_000_000_000 + ts.header.stamp.nanosec
+            transform = Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w))
+            edge = self.edges.get(child)
+            if edge is None or edge.parent != parent or edge.static != static:
+                edge = self.edges[child] = Edge(parent, child, static, transform, stamp)
+                edge.oldest_stamp_ns = stamp
+            edge.transform, edge.stamp_ns = transform, stamp
+            edge.senders.add(sender)
+            edge.received.append(received_ns)
+
+    def frames(self) -> set[str]:
+        """Every frame named as a parent or a child."""
+        return {*self.edges, *(e.parent for e in self.edges.values())}
+
+    def path_to_root(self, frame: str) -> list[str]:
+        """``frame``, its parent, ... up to its root (stops on a cycle)."""
+        path = [frame]
+        while path[-1] in self.edges and self.edges[path[-1]].parent not in path:
+            path.append(self.edges[path[-1]].parent)
+        return path
+
+    def roots(self) -> list[str]:
+        """Frames without a parent, sorted."""
+        return sorted(f for f in self.frames() if f not in self.edges)
+
+    def children(self, frame: str) -> list[Edge]:
+        """The edges below ``frame``, sorted by child name."""
+        return sorted((e for e in self.edges.values() if e.parent == frame), key=lambda e: e.child)
+
+    def lookup(self, source: str, target: str) -> tuple[Transform, int]:
+        """The pose of ``target`` in ``source`` (tf2_echo SOURCE TARGET) and its stamp (ns).
+
+        Raises:
+            IntrospectionError: a frame is unknown, or the two are not connected.
+        """
+        for frame in (source, target):
+            if frame not in self.frames():
+                raise IntrospectionError(_unknown_frame(frame, self.frames()))
+        up_source, up_target = self.path_to_root(source), self.path_to_root(target)
+        common = next((f for f in up_source if f in up_target), None)
+        if common is None:
+            raise IntrospectionError(
+                f"frames '{source}' and '{target}' are not connected: '{source}' is in the tree "
+                f"of '{up_source[-1]}', '{target}' in the tree of '{up_target[-1]}'"
+            )
+        chain = [*up_source[: up_source.index(common)], *up_target[: up_target.index(common)]]
+        stamps = [self.edges[f].stamp_ns for f in chain if not self.edges[f].static]
+        pose = self._down(up_source, common).inverse() * self._down(up_target, common)
+        return pose, min(stamps, default=0)
+
+    def _down(self, path: list[str], ancestor: str) -> Transform:
+        """ancestor←frame, for ``path`` = frame ... ancestor ... (from :meth:`path_to_root`)."""
+        result = Transform()
+        for child in reversed(path[: path.index(ancestor)]):
+            result = result * self.edges[child].transform
+        return result
+
+
+def _unknown_frame(frame: str, known: set[str]) -> str:
+    ranked = sorted(known, key=lambda k: (-difflib.SequenceMatcher(None, frame, k).ratio(), k))
+    return f"frame '{frame}' does not exist; known frames: {', '.join(ranked)}"
+
+
+# --- listening --------------------------------------------------------------------------------
+
+
+class TfListener:
+    """Subscribes to /tf and /tf_static with the command's hidden node."""
+
+    def __init__(self, session: Session) -> None:
+        import rosl
+        from rosl.node.qos import DurabilityPolicy, QoSProfile
+
+        self.session = session
+        self.buffer = TfBuffer()
+        msg_type = rosl.get_interface("tf2_msgs/msg/TFMessage")
+        node = session.node()
+        durabilities = (DurabilityPolicy.VOLATILE, DurabilityPolicy.TRANSIENT_LOCAL)
+        for topic, durability in zip(TOPICS, durabilities, strict=True):
+            node.create_subscription(
+                msg_type,
+                topic,
+                self._callback(topic == "/tf_static"),  # type: ignore[arg-type]
+                QoSProfile(depth=100, durability=durability),
+            )
+        self._executor = rosl.SingleThreadedExecutor()
+        self._executor.add_node(node)
+
+    def _callback(self, static: bool) -> Any:
+        def deliver(message: Any, info: dict[str, Any]) -> None:
+            received = info.get("received_timestamp") or time.time_ns()
+            self.buffer.add(message, static, tuple(info["publisher_gid"]), received)
+
+        return deliver
+
+    def spin_for(self, seconds: float) -> None:
+        """Take messages for ``seconds``."""
+        deadline = time.monotonic() + seconds
+        while (left := deadline - time.monotonic()) > 0:
+            self._executor.spin_once(timeout_sec=min(left, 0.05))
+
+    def name_broadcasters(self) -> None:
+        """Fill each edge's broadcaster names from the graph (by publisher id)."""
+        publishers = {
+            (node.process, e.endpoint): (node.fqn, e.name)
+            for topic in TOPICS
+            for node, e in self.session.graph(fresh=True).endpoints(PUBLISHER, topic)
+        }
+        for edge in self.buffer.edges.values():
+            topic = TOPICS[edge.static]
+            names = {publishers[s][0] for s in edge.senders if s in publishers}
+            if not names:  # publisher gone meanwhile: everyone publishing that topic
+                names = {n for n, t in publishers.values() if t == topic} or {"unknown"}
+            edge.broadcasters = tuple(sorted(names))
+
+
+def _no_data(wait_time: float) -> IntrospectionError:
+    return IntrospectionError(f"no TF data received on /tf or /tf_static within {wait_time} s")
+
+
+def frames(session: Session, wait_time: float) -> TfBuffer:
+    """Listen for ``wait_time`` seconds and return what was heard.
+
+    Raises:
+        IntrospectionError: no transform at all arrived.
+    """
+    listener = TfListener(session)
+    listener.spin_for(wait_time)
+    if not listener.buffer.edges:
+        raise _no_data(wait_time)
+    listener.name_broadcasters()
+    return listener.buffer
+
+
+def echo(
+    session: Session, source: str, target: str, *, wait_time: float, once: bool, rate: float
+) -> Iterator[str]:
+    """Yield tf2_echo's block for SOURCE→TARGET now, then every ``1/rate`` s (until Ctrl-C).
+
+    Raises:
+        IntrospectionError: no data, an unknown frame, or frames not connected within the wait.
+    """
+    listener = TfListener(session)
+    deadline = time.monotonic() + wait_time
+    while True:
+        listener.spin_for(0.05)
+        try:
+            transform, stamp = listener.buffer.lookup(source, target)
+            break
+        except IntrospectionError:
+            if time.monotonic() < deadline:
+                continue
+            if not listener.buffer.edges:
+                raise _no_data(wait_time) from None
+            raise
+    while True:
+        yield echo_text(transform, stamp)
+        if once:
+            return
+        listener.spin_for(1.0 / rate if rate > 0 else 1.0)
+        transform, stamp = listener.buffer.lookup(source, target)
+
+
+# --- rendering --------------------------------------------------------------------------------
+
+
+def _fmt(values: tuple[float, ...]) -> str:
+    return "[" + ", ".join(f"{round(v, 3) + 0.0:.3f}" for v in values) + "]"
+
+
+def echo_text(transform: Transform, stamp_ns: int) -> str:
+    """tf2_echo's block: time, translation, quaternion, RPY in radians and degrees, matrix."""
+    rpy = transform.rpy()
+    x, y, z, w = transform.rotation
+    rows = [
+        (1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
+        (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
+        (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)),
+    ]
+    matrix = [(*row, transform.translation[i]) for i, row in enumerate(rows)] + [(0, 0, 0, 1)]
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    return "\n".join(
+        [
+            f"At time {sec}.{nanosec:09d}",
+            f"- Translation: {_fmt(transform.translation)}",
+            f"- Rotation: in Quaternion {_fmt(transform.rotation)}",
+            f"- Rotation: in RPY (radian) {_fmt(rpy)}",
+            f"- Rotation: in RPY (degree) {_fmt(tuple(math.degrees(a) for a in rpy))}",
+            "- Matrix:",
+            *("  " + " ".join(f"{round(v, 3) + 0.0:6.3f}" for v in row) for row in matrix),
+        ]
+    )
+
+
+def _about(edge: Edge) -> str:
+    who = ", ".join(edge.broadcasters) or "unknown"
+    if edge.static:
+        return f"broadcaster: {who}, static"
+    rate = edge.rate
+    return f"broadcaster: {who}, average rate: {rate:.1f} Hz" if rate else f"broadcaster: {who}"
+
+
+def _walk(buffer: TfBuffer) -> Iterator[tuple[int, Edge | None, str]]:
+    """(depth, edge into the frame or None for a root, frame), depth first, sorted."""
+    seen: set[str] = set()
+
+    def below(frame: str, depth: int) -> Iterator[tuple[int, Edge | None, str]]:
+        for edge in buffer.children(frame):
+            if edge.child not in seen:
+                seen.add(edge.child)
+                yield depth, edge, edge.child
+                yield from below(edge.child, depth + 1)
+
+    for root in buffer.roots():
+        seen.add(root)
+        yield 0, None, root
+        yield from below(root, 1)
+    for frame in sorted(buffer.frames() - seen):  # frames in a cycle have no root
+        seen.add(frame)
+        yield 0, None, f"{frame} (in a cycle)"
+        yield from below(frame, 1)
+
+
+def frames_text(buffer: TfBuffer) -> str:
+    """The tree as indented text, roots first."""
+    lines = [
+        f"{'  ' * depth}{frame}" + (f"  ({_about(edge)})" if edge else "")
+        for depth, edge, frame in _walk(buffer)
+    ]
+    roots = buffer.roots()
+    if len(roots) > 1:
+        lines.append(f"note: {len(roots)} separate trees (roots: {', '.join(roots)})")
+    return "\n".join(lines) + "\n"
+
+
+def frames_dot(buffer: TfBuffer, recorded_ns: int | None = None) -> str:
+    """view_frames' DOT: one labelled edge per transform and the 'Recorded at time' legend."""
+    out = ["digraph G {"]
+    for _, edge, _ in _walk(buffer):
+        if edge is None:
+            continue
+        span = 0.0 if edge.static else (edge.received[-1] - edge.received[0]) / 1e9
+        rate = "static" if edge.static else f"{round(edge.rate or 0.0, 3)}"
+        out.append(
+            f'"{edge.parent}" -> "{edge.child}"[label=" Broadcaster: '
+            f"{', '.join(edge.broadcasters) or 'unknown'}\\nAverage rate: {rate}\\n"
+            f"Buffer length: {round(span, 3)}\\nMost recent transform: {edge.stamp_ns / 1e9}\\n"
+            f'Oldest transform: {edge.oldest_stamp_ns / 1e9}\\n"];'
+        )
+    recorded = (time.time_ns() if recorded_ns is None else recorded_ns) / 1e9
+    root = next(iter(buffer.roots()), next(iter(sorted(buffer.frames())), ""))
+    out += [
+        "edge [style=invis];",
+        ' subgraph cluster_legend { style=bold; color=black; label ="view_frames Result";',
+        f'"Recorded at time: {recorded}"[ shape=plaintext ] ;',
+        f'}}->"{root}";',
+        "}",
+    ]
+    return "\n".join(out) + "\n"
+
+
+def output_format(path: Path) -> str:
+    """``dot``, ``text`` or a Graphviz format for ``-o``; checks Graphviz is there first.
+
+    Raises:
+        IntrospectionError: an unknown suffix, or Graphviz's ``dot`` is missing.
+    """
+    from rosl.introspection.graph_view import GRAPHVIZ_FORMATS, require_graphviz
+
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix in ("dot", "gv", "txt"):
+        return "text" if suffix == "txt" else "dot"
+    if suffix in GRAPHVIZ_FORMATS:
+        require_graphviz(suffix, "-o FILE.dot, or the text tree")
+        return suffix
+    raise IntrospectionError(
+        f"cannot write '{path}': unknown file type (use .dot, .gv, .txt, "
+        f"{', '.join('.' + f for f in GRAPHVIZ_FORMATS)})"
+    )
+
+
+def export(buffer: TfBuffer, path: Path) -> None:
+    """Write the tree to ``path`` (text, DOT, or svg/png/pdf through Graphviz)."""
+    from rosl.introspection.graph_view import write
+
+    fmt = output_format(path)
+    write(path, frames_text(buffer) if fmt == "text" else frames_dot(buffer), fmt)
