@@ -139,6 +139,7 @@ class Reader:
         self.unwanted = 0  # rosl datagrams of topics nobody here listens to
         self.streams: dict[tuple[int, int], StreamStats] = {}
         self.reassembler = Reassembler()
+        self._next_expiry = 0
 
     def drain(self, sock: socket.socket, out: list[Delivery], limit: int = 256) -> bool:
         """Read up to ``limit`` ready datagrams from ``sock`` into ``out``.
@@ -151,6 +152,11 @@ class Reader:
         """
         wanted, want_all = self.wanted, self.want_all
         recv = sock.recv
+        if self.reassembler.pending:  # drop (and count) messages whose fragments stopped coming
+            now = time.time_ns()
+            if now >= self._next_expiry:
+                self._next_expiry = now + 250_000_000
+                self.reassembler.expire(now)
         for _ in range(limit):
             try:
                 data = recv(65536)

@@ -104,10 +104,11 @@ class Discovery:
         if self._stopping:
             return
         self._stopping = True
-        self._send({"op": "bye", "sender": f"{self.sender:016x}"})
         self._wake()
         if self._thread.is_alive() and threading.current_thread() is not self._thread:
             self._thread.join(timeout=2.0)
+        # last, so no announcement still being made can overtake the goodbye
+        self._send({"op": "bye", "sender": f"{self.sender:016x}"})
         for fd in (self._wake_read, self._wake_write):
             with contextlib.suppress(OSError):
                 os.close(fd)

@@ -68,6 +68,8 @@ class Duration:
         return hash(self._ns)
 
     def __add__(self, other: Duration) -> Duration:
+        if not isinstance(other, Duration):
+            return NotImplemented  # Duration + Time is Time.__radd__
         return Duration(nanoseconds=self._ns + other._ns)
 
     def __sub__(self, other: Duration) -> Duration:

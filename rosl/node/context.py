@@ -46,6 +46,7 @@ class Context:
             self.domain_id = domain_id
             self._initialized = True
             self._shutdown_requested = False
+            rlog.set_console_output(self.args.enable_stdout_logs)
             for name, level in self.args.log_levels.items():
                 if name is None:
                     rlog.set_default_level(level)

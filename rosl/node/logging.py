@@ -38,6 +38,7 @@ _COLORS = {
 }
 _levels: dict[str, LoggingSeverity] = {}
 _default_level = LoggingSeverity.INFO
+_console = True  # --disable-stdout-logs turns console output off (/rosout still gets records)
 _lock = threading.Lock()
 Sink = Callable[[LoggingSeverity, str, str, str, str, int], None]
 
@@ -59,6 +60,12 @@ def set_default_level(level: str | int | LoggingSeverity) -> None:
 def set_logger_level(name: str, level: str | int | LoggingSeverity) -> None:
     """Set one logger's level (``--log-level talker:=debug``)."""
     _levels[name] = parse_severity(level)
+
+
+def set_console_output(enabled: bool) -> None:
+    """Turn printing of log lines on or off (``--disable-stdout-logs``)."""
+    global _console
+    _console = enabled
 
 
 def effective_level(name: str) -> LoggingSeverity:
@@ -149,12 +156,13 @@ class Logger:
         line = format_line(level, self.name, message, stamp)
         if _use_color(stream) and level in _COLORS:
             line = f"{_COLORS[level]}{line}\033[0m"
-        with _lock:
-            try:
-                stream.write(line + "\n")
-                stream.flush()
-            except (OSError, ValueError):
-                pass
+        if _console:
+            with _lock:
+                try:
+                    stream.write(line + "\n")
+                    stream.flush()
+                except (OSError, ValueError):
+                    pass
         if self._sink is not None:
             frame = inspect.stack(context=0)[3] if len(inspect.stack(context=0)) > 3 else None
             where = (frame.filename, frame.function, frame.lineno) if frame else ("", "", 0)

@@ -96,7 +96,8 @@ class Node:
             "rcl_interfaces/msg/ParameterEvent", "/parameter_events", qos_profile_parameter_events
         )
         self._parameters.add_callback(self._on_use_sim_time)
-        self.declare_parameter("use_sim_time", False)
+        sim_time = self.declare_parameter("use_sim_time", False)
+        self._set_sim_time(sim_time.type_ is ParameterType.BOOL and bool(sim_time.value))
         if automatically_declare_parameters_from_overrides:
             for key, value in overrides.items():
                 if not self.has_parameter(key):
@@ -253,6 +254,7 @@ class Node:
 
     def destroy_publisher(self, publisher: Publisher) -> bool:
         """Remove a publisher."""
+        self.participant.remove_replayer(publisher.topic, publisher)
         return self._remove(self.publishers, publisher)
 
     def destroy_subscription(self, subscription: Subscription) -> bool:
@@ -296,6 +298,8 @@ class Node:
             client.close()
         for timer in self.timers:
             timer.destroy()
+        for publisher in self.publishers:
+            self.participant.remove_replayer(publisher.topic, publisher)
         self.participant.remove_node(self.index)
         if self in self.context.nodes:
             self.context.nodes.remove(self)

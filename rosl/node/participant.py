@@ -35,6 +35,13 @@ class Handler(Protocol):
         """Handle one complete message."""
 
 
+class Replayer(Protocol):
+    """A publisher that keeps history for late transient-local subscribers."""
+
+    def replay(self, target: tuple[int, int]) -> None:
+        """Send the kept messages to one subscription (process, endpoint)."""
+
+
 class Participant:
     """The process's presence on one domain."""
 
@@ -52,7 +59,9 @@ class Participant:
         self._wake_read, self._wake_write = os.pipe()
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
+        self._replayers: dict[str, list[Replayer]] = {}
         self.discovery = Discovery(self.transport, self.sender, self._describe)
+        self.discovery.handlers["replay"] = self._on_replay_request
         self.closed = False
         self.discovery.start()
 
@@ -80,6 +89,28 @@ class Participant:
     def next_endpoint(self) -> int:
         """A new endpoint number, unique in this process."""
         return next(self._endpoint_ids) & 0xFFFF
+
+    def add_replayer(self, topic: str, publisher: Replayer) -> None:
+        """Register a publisher that answers history requests on ``topic``."""
+        with self._lock:
+            self._replayers.setdefault(topic, []).append(publisher)
+
+    def remove_replayer(self, topic: str, publisher: Replayer) -> None:
+        """Unregister a history-keeping publisher."""
+        with self._lock:
+            publishers = self._replayers.get(topic, [])
+            if publisher in publishers:
+                publishers.remove(publisher)
+
+    def _on_replay_request(self, message: dict[str, object]) -> None:
+        # runs on the discovery thread: a late transient-local subscription asks for history
+        topic = str(message["topic"])
+        sender, endpoint = message["target"]  # type: ignore[misc]
+        target = (int(str(sender), 16), int(endpoint))
+        with self._lock:
+            publishers = list(self._replayers.get(topic, ()))
+        for publisher in publishers:
+            publisher.replay(target)
 
     def listen(self, topic: int, handler: Handler) -> None:
         """Deliver messages of a topic/service hash to ``handler`` (joins its channel)."""

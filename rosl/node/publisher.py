@@ -35,6 +35,8 @@ class Publisher:
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
         )
         self.destroyed = False
+        if self._history is not None:
+            participant.add_replayer(topic, self)
 
     @property
     def topic_name(self) -> str:
@@ -80,7 +82,6 @@ class Publisher:
 
     def destroy(self) -> None:
         """Stop publishing (rclpy: node.destroy_publisher)."""
-        self.destroyed = True
         self.node.destroy_publisher(self)
 
     def assert_liveliness(self) -> None:
