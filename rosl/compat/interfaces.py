@@ -59,6 +59,9 @@ class _Loader(importlib.abc.Loader):
             module = types.ModuleType(spec.name)
             module.__path__ = []
             return module
+        from rosl.idl import registry
+
+        registry.on_clear(_forget_cached_classes)
         module = InterfaceModule(spec.name, self.package, self.kind)
         module.__file__ = str(search_path.find_package(self.package).path / self.kind)
         return module
@@ -112,6 +115,13 @@ class InterfaceFinder(importlib.abc.MetaPathFinder):
 
 
 _finder = InterfaceFinder()
+
+
+def _forget_cached_classes() -> None:
+    for module in list(sys.modules.values()):
+        if isinstance(module, InterfaceModule):
+            for attr in [a for a in vars(module) if not a.startswith("__")]:
+                delattr(module, attr)
 
 
 def install() -> None:

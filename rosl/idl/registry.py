@@ -18,6 +18,7 @@ from rosl.idl.names import TypeName, did_you_mean, parse_type_name
 from rosl.idl.parser import FieldType, MessageSpec, ServiceSpec, parse_message, parse_service
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
     from rosl.idl.messages import Message, ServiceType
@@ -29,6 +30,7 @@ _classes: dict[str, type[Message]] = {}
 _services: dict[str, type[ServiceType]] = {}
 _loading: list[str] = []
 _store: Store | None = None
+_clear_hooks: list[Callable[[], None]] = []  # e.g. import-hook modules dropping cached classes
 
 
 def store() -> Store:
@@ -298,3 +300,11 @@ def clear() -> None:
         _services.clear()
         _store = None
     search_path.rescan()
+    for hook in _clear_hooks:
+        hook()
+
+
+def on_clear(hook: Callable[[], None]) -> None:
+    """Call ``hook`` whenever :func:`clear` forgets the loaded types."""
+    if hook not in _clear_hooks:
+        _clear_hooks.append(hook)

@@ -95,14 +95,16 @@ def test_the_timer_node_ticks_at_its_parameter_period_and_speeds_up_when_it_is_s
     from rosl import Parameter
 
     node = tutorial("timer_node", "--ros-args", "-p", "timer_period_s:=0.25")
-    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.25 s", "err", timeout=10.0), (
-        node.text("err")
+    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.25 s", "err", timeout=10.0), node.text(
+        "err"
     )
     assert node.wait_for(TICK, "err", timeout=10.0, count=8)  # 2 s of ticks at 4 Hz
 
     client = observer_node.create_client(SetParameters, "/timer_node/set_parameters")
     assert client.wait_for_service(timeout_sec=10.0)
-    request = SetParameters.Request(parameters=[Parameter("timer_period_s", value=0.1).to_parameter_msg()])
+    request = SetParameters.Request(
+        parameters=[Parameter("timer_period_s", value=0.1).to_parameter_msg()]
+    )
     response = client.call(request, timeout_sec=10.0)
     assert [r.successful for r in response.results] == [True]
     assert node.wait_for(PERIOD_CHANGED, "err", timeout=5.0)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import fcntl
 import random
+import subprocess
 from typing import TYPE_CHECKING
 
 import pytest
@@ -22,8 +23,11 @@ if TYPE_CHECKING:
 def watch(processes: Processes) -> Callable[..., Watched]:
     """Start a Python snippet on the test's domain with its output read line by line."""
 
-    def start(code: str, *args: str, env: dict[str, str] | None = None) -> Watched:
-        return Watched(processes.python(code, *args, env=env))
+    def start(
+        code: str, *args: str, env: dict[str, str] | None = None, stdin: int | None = None
+    ) -> Watched:
+        stdin = subprocess.DEVNULL if stdin is None else stdin
+        return Watched(processes.python(code, *args, env=env, stdin=stdin))
 
     return start
 

@@ -60,7 +60,9 @@ class Watched:
         found = (re.search(pattern, line) for line in self.lines(stream))
         return [m for m in found if m is not None]
 
-    def wait_for(self, pattern: str, stream: str = "out", timeout: float = 10.0, count: int = 1) -> bool:
+    def wait_for(
+        self, pattern: str, stream: str = "out", timeout: float = 10.0, count: int = 1
+    ) -> bool:
         """Wait until ``count`` lines match ``pattern`` (or the child ends, or the timeout)."""
         deadline = time.monotonic() + timeout
         with self._changed:
@@ -83,6 +85,12 @@ class Watched:
 
     def _alive(self) -> bool:
         return any(reader.is_alive() for reader in self._readers)
+
+    def tell(self, line: str) -> None:
+        """Write a line to the child's stdin (start it with ``stdin=subprocess.PIPE``)."""
+        assert self.child.stdin is not None
+        self.child.stdin.write(line + "\n")
+        self.child.stdin.flush()
 
     def send(self, sig: int = signal.SIGINT) -> None:
         """Send a signal to the child (by pid), once: a second Ctrl-C means "now"."""
@@ -111,7 +119,9 @@ def wait_for_node(graph: GraphCache, fqn: str, timeout: float = 10.0) -> NodeRec
     return graph.find_node(fqn)[0]
 
 
-def leaving_time(graph: GraphCache, sender: int, act: Callable[[], None], timeout: float) -> tuple[float, float] | None:
+def leaving_time(
+    graph: GraphCache, sender: int, act: Callable[[], None], timeout: float
+) -> tuple[float, float] | None:
     """Do ``act`` and watch process ``sender`` leave the graph.
 
     Returns:

@@ -21,7 +21,9 @@ INT32 = "std_msgs/msg/Int32"
 TRIGGER = "std_srvs/srv/Trigger"
 
 
-def node(sender: int, index: int, name: str, *endpoints: EndpointRecord, ns: str = "/") -> NodeRecord:
+def node(
+    sender: int, index: int, name: str, *endpoints: EndpointRecord, ns: str = "/"
+) -> NodeRecord:
     return NodeRecord(name, ns, sender, index, endpoints)
 
 
@@ -124,7 +126,13 @@ def crowded_cache() -> GraphCache:
     cache.update(
         process(
             1,
-            node(1, 1, "talker", ep(PUBLISHER, "/chatter", STRING, 1), ep(SERVER, "/reset", TRIGGER, 2)),
+            node(
+                1,
+                1,
+                "talker",
+                ep(PUBLISHER, "/chatter", STRING, 1),
+                ep(SERVER, "/reset", TRIGGER, 2),
+            ),
             node(1, 2, "counter", ep(PUBLISHER, "/chatter", INT32, 3)),
         )
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 import time
 from typing import TYPE_CHECKING
 
@@ -153,7 +154,6 @@ def test_rosl_nodes_see_other_processes_through_the_node_graph_api(
     assert ("/demo/reset", ["std_srvs/srv/Trigger"]) in node.get_service_names_and_types()
 
 
-@pytest.mark.slow
 def test_a_fresh_participant_query_completes_holding_every_node_of_every_process(
     watch: Callable[..., Watched], domain_id: int
 ) -> None:
@@ -207,9 +207,7 @@ def test_a_node_shut_down_with_ctrl_c_leaves_the_graph_at_once_by_saying_goodbye
     child.wait_ready()
     leaver = wait_for_node(observer.graph, "/leaver")
 
-    timing = leaving_time(
-        observer.graph, leaver.process, child.send, 3 * LEASE_S
-    )
+    timing = leaving_time(observer.graph, leaver.process, child.send, 3 * LEASE_S)
 
     assert timing is not None, "the node never left the graph"
     last_seen, gone_at = timing
@@ -308,8 +306,8 @@ def test_a_subscription_reports_its_growing_received_count_in_announcements(
     for value in range(3):
         pub.publish(Int32(data=value))
     assert listener.wait_for(r"^got 2$", timeout=5.0), listener.text("err")
-    assert wait_until(lambda: stat(SUBSCRIPTION, "received") == 3, timeout=5.0), (
-        graph.endpoints(SUBSCRIPTION, "/counts")
+    assert wait_until(lambda: stat(SUBSCRIPTION, "received") == 3, timeout=5.0), graph.endpoints(
+        SUBSCRIPTION, "/counts"
     )
 
     for value in range(3, 7):
@@ -320,3 +318,99 @@ def test_a_subscription_reports_its_growing_received_count_in_announcements(
     # the publisher's own count travels the same way (this process hears itself)
     assert wait_until(lambda: stat(PUBLISHER, "sent") == 7, timeout=5.0)
     assert listener.interrupt() == 0
+
+
+SLOW_TO_DESCRIBE = """
+import subprocess
+import time
+import rosl
+
+class SlowToDescribe(rosl.Node):
+    # describing this node takes a while, as it does for big nodes or a busy interpreter
+    def record(self):
+        found = super().record()
+        time.sleep(0.3)
+        return found
+
+rosl.init([])
+first = rosl.Node("first")
+slow = SlowToDescribe("slow")
+print("ready", flush=True)
+rosl.spin(first)
+first.destroy_node()  # announced at once: the discovery thread starts describing "slow"
+time.sleep(0.05)
+rosl.shutdown()  # ... and the goodbye goes out while it is still at it
+print("bye", flush=True)
+"""
+
+
+def test_a_goodbye_is_not_overtaken_by_an_announcement_still_being_made(
+    watch: Callable[..., Watched], observer: Participant
+) -> None:
+    child = watch(SLOW_TO_DESCRIBE)
+    child.wait_ready()
+    wait_for_node(observer.graph, "/slow")
+    wait_for_node(observer.graph, "/first")
+
+    assert child.interrupt() == 0
+    assert "bye" in child.lines("out")
+    time.sleep(0.5)  # let this process read whatever the child sent before it exited
+    # the process said goodbye and exited: nothing of it may linger until its lease runs out
+    lingering = [n.fqn for n in observer.graph.nodes()]
+    assert lingering == [], (
+        f"{lingering} still in the graph after its process said goodbye and exited: an "
+        "announcement started before the goodbye was sent after it"
+    )
+
+
+DESTROY_ON_REQUEST = """
+import sys
+import rosl
+
+rosl.init([])
+nodes = {name: rosl.Node(name) for name in sys.argv[1:]}
+print("ready", flush=True)
+for line in sys.stdin:  # one node name per line: destroy it, the process lives on
+    nodes[line.strip()].destroy_node()
+    print("destroyed", line.strip(), flush=True)
+rosl.shutdown()
+"""
+
+
+def test_a_destroyed_node_leaves_the_graph_while_its_process_keeps_running(
+    watch: Callable[..., Watched], observer: Participant
+) -> None:
+    child = watch(DESTROY_ON_REQUEST, "keeper", "passing", stdin=subprocess.PIPE)
+    child.wait_ready()
+    wait_for_node(observer.graph, "/keeper")
+    wait_for_node(observer.graph, "/passing")
+
+    child.tell("passing")
+    assert child.wait_for(r"^destroyed passing$", timeout=5.0)
+
+    graph = observer.graph
+    assert graph.wait_for(lambda: graph.find_node("/passing") == [], 5.0)
+    assert [n.fqn for n in graph.nodes()] == ["/keeper"]
+
+
+def test_destroying_the_last_node_of_a_running_process_removes_it_at_once(
+    watch: Callable[..., Watched], observer: Participant
+) -> None:
+    child = watch(DESTROY_ON_REQUEST, "only", stdin=subprocess.PIPE)
+    child.wait_ready()
+    only = wait_for_node(observer.graph, "/only")
+
+    def destroy() -> None:
+        child.tell("only")
+        assert child.wait_for(r"^destroyed only$", timeout=5.0)
+
+    timing = leaving_time(observer.graph, only.process, destroy, 3 * LEASE_S)
+
+    assert timing is not None, "/only never left the graph"
+    last_seen, gone_at = timing
+    assert child.child.poll() is None  # the process is still running
+    # the change was announced, not left to the lease (rclpy removes destroyed nodes at once)
+    assert gone_at - last_seen < LEASE_S, (
+        f"/only stayed in the graph {gone_at - last_seen:.1f} s after its process was last "
+        "heard from: the lease removed it, nothing announced that it was destroyed"
+    )

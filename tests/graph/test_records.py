@@ -108,9 +108,7 @@ def test_a_gid_is_sixteen_dot_joined_two_digit_hex_bytes() -> None:
 
 
 def test_a_gid_holds_the_process_id_then_the_endpoint_little_endian_then_zeros() -> None:
-    assert gid(0x0102030405060708, 0x0A0B) == (
-        "08.07.06.05.04.03.02.01.0b.0a.00.00.00.00.00.00"
-    )
+    assert gid(0x0102030405060708, 0x0A0B) == ("08.07.06.05.04.03.02.01.0b.0a.00.00.00.00.00.00")
     assert gid(1, 1) != gid(1, 2)
     assert gid(1, 1) != gid(2, 1)
 

@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import codecs
+import contextlib
 import os
 import re
 import select
+import subprocess
 import textwrap
 import time
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    import subprocess
     from collections.abc import Callable
 
     from tests.conftest import Processes
@@ -57,15 +58,18 @@ class Child:
         """The next match of ``pattern`` (multiline regex) after the last one, or None."""
         regex = re.compile(pattern, re.MULTILINE)
         deadline = time.monotonic() + timeout
+        last_look = False
         while True:
             match = regex.search(self.text[stream], self._pos[stream])
             if match:
                 self._pos[stream] = match.end()
                 return match
-            remaining = deadline - time.monotonic()
-            if remaining <= 0 or (not self._open and self.popen.poll() is not None):
+            if last_look or (not self._open and self.popen.poll() is not None):
                 return None
-            self._read(min(remaining, 0.05))
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                last_look = True  # one more read of what is already there, then give up
+            self._read(max(0.0, min(remaining, 0.05)))
 
     def expect(self, pattern: str, *, stream: str = "out", timeout: float = 10.0) -> Any:
         """Like :meth:`wait_for` but fail the test with the child's output when missing."""
@@ -85,6 +89,15 @@ class Child:
         return len(re.findall(pattern, self.text[stream], re.MULTILINE))
 
     # --- ending ----------------------------------------------------------------------------
+
+    def finish(self, timeout: float = 10.0) -> tuple[str, str]:
+        """Wait (bounded) for the child to exit on its own; Ctrl-C it if it does not."""
+        deadline = time.monotonic() + timeout
+        while self._open and (remaining := deadline - time.monotonic()) > 0:
+            self._read(min(remaining, 0.05))
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            self.popen.wait(timeout=max(0.1, deadline - time.monotonic()))
+        return self.stop()
 
     def stop(self, timeout: float = 5.0) -> tuple[str, str]:
         """Ctrl-C the child (SIGKILL after ``timeout``); return all of its stdout and stderr."""

@@ -103,9 +103,7 @@ def test_a_params_file_applies_wildcards_then_the_node_section(ros, tmp_path):
 def test_command_line_p_wins_over_a_params_file(ros, tmp_path):
     params = tmp_path / "params.yaml"
     params.write_text("/**:\n  ros__parameters:\n    level: 1\n")
-    node = ros.Node(
-        "both", cli_args=["--ros-args", "--params-file", str(params), "-p", "level:=2"]
-    )
+    node = ros.Node("both", cli_args=["--ros-args", "--params-file", str(params), "-p", "level:=2"])
     assert node.declare_parameter("level", 0).value == 2
 
 
@@ -358,7 +356,9 @@ def test_parameter_changes_are_published_on_parameter_events(ros, spawn):
     setter = node.create_client(SetParameters, "/remote_params/set_parameters")
     assert setter.wait_for_service(timeout_sec=8.0)
 
-    request = SetParameters.Request(parameters=[ros.Parameter("gain", value=7.25).to_parameter_msg()])
+    request = SetParameters.Request(
+        parameters=[ros.Parameter("gain", value=7.25).to_parameter_msg()]
+    )
     assert setter.call(request, timeout_sec=5.0).results[0].successful
 
     def changed_gain():
@@ -400,3 +400,69 @@ def test_the_nodes_own_declarations_and_sets_are_published_on_parameter_events(r
     changed = [p for e in mine() for p in e.changed_parameters if p.name == "threshold"]
     assert [_value(p.value) for p in new] == [0.25]
     assert [_value(p.value) for p in changed] == [0.75]
+
+
+def test_an_override_of_the_wrong_type_makes_the_declaration_fail(ros):
+    from rosl.node.errors import InvalidParameterTypeException
+
+    node = ros.Node("overridden", cli_args=["--ros-args", "-p", "rate:=fast"])
+    with pytest.raises(InvalidParameterTypeException) as err:
+        node.declare_parameter("rate", 1.0)
+    assert str(err.value) == WRONG_TYPE.format(name="rate", declared="double", given="string")
+
+
+def test_an_integer_range_with_a_step_refuses_values_off_the_step(ros):
+    from rcl_interfaces.msg import IntegerRange, ParameterDescriptor
+
+    node = ros.Node("stepped")
+    descriptor = ParameterDescriptor(
+        integer_range=[IntegerRange(from_value=0, to_value=10, step=2)]
+    )
+    node.declare_parameter("k", 4, descriptor)
+    results = node.set_parameters(
+        [ros.Parameter("k", value=5), ros.Parameter("k", value=6), ros.Parameter("k", value=12)]
+    )
+    assert [r.successful for r in results] == [False, True, False]
+    assert node.get_parameter("k").value == 6
+
+
+def test_parameters_declared_under_a_namespace_are_found_by_prefix(ros):
+    node = ros.Node("prefixed")
+    node.declare_parameters("cam", [("fps", 30), ("name", "front")])
+    found = node.get_parameters_by_prefix("cam")
+    assert {k: p.value for k, p in found.items()} == {"fps": 30, "name": "front"}
+    node.undeclare_parameter("cam.fps")
+    assert not node.has_parameter("cam.fps")
+    assert [p.value for p in node.get_parameters(["cam.name"])] == ["front"]
+
+
+def test_overrides_can_be_declared_automatically_and_undeclared_ones_allowed(ros):
+    node = ros.Node(
+        "auto",
+        cli_args=["--ros-args", "-p", "speed:=2.5", "-p", "label:=left"],
+        automatically_declare_parameters_from_overrides=True,
+    )
+    assert node.get_parameter("speed").value == 2.5
+    assert node.get_parameter("label").value == "left"
+
+    loose = ros.Node("loose", allow_undeclared_parameters=True)
+    assert loose.get_parameter("anything").type_ is ros.Parameter.Type.NOT_SET
+    assert loose.set_parameters([ros.Parameter("anything", value=3)])[0].successful
+    assert loose.get_parameter("anything").value == 3
+
+
+def test_a_namespaced_nodes_parameter_services_live_under_its_full_name(ros):
+    from rcl_interfaces.srv import GetParameters
+
+    node = ros.Node("cam", namespace="/robot")
+    node.declare_parameter("fps", 30)
+    other = ros.Node("asker")
+    client = other.create_client(GetParameters, "/robot/cam/get_parameters")
+    assert client.wait_for_service(timeout_sec=5.0)
+    future = client.call_async(GetParameters.Request(names=["fps"]))
+    ros.spin_until_future_complete(other, future, timeout_sec=5.0)
+    assert future.done()
+    assert future.result().values[0].integer_value == 30
+    assert ("/robot/cam/set_parameters", ["rcl_interfaces/srv/SetParameters"]) in (
+        other.get_service_names_and_types()
+    )

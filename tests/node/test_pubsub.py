@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import threading
 
 import pytest
@@ -244,3 +245,72 @@ def test_publishing_a_message_of_the_wrong_type_names_both_types(ros):
         pub.publish(Int32(data=1))
     assert "std_msgs/msg/String" in str(err.value)
     assert "std_msgs/msg/Int32" in str(err.value)
+
+
+def test_a_callback_taking_two_arguments_also_gets_the_message_info(ros):
+    from std_msgs.msg import Int32
+
+    node = ros.Node("info_reader")
+    pub = node.create_publisher(Int32, "with_info", 10)
+    got: list[tuple[int, dict]] = []
+    node.create_subscription(Int32, "with_info", lambda m, info: got.append((m.data, info)), 10)
+
+    assert spin_until(node, lambda: bool(got), 5.0, each=lambda: pub.publish(Int32(data=5)))
+    data, info = got[0]
+    assert data == 5
+    assert info["publication_sequence_number"] >= 1
+    assert info["reception_sequence_number"] == 1
+    assert info["received_timestamp"] >= info["source_timestamp"] > 0
+
+
+def test_a_destroyed_subscription_receives_nothing_more(ros):
+    from std_msgs.msg import Int32
+
+    node = ros.Node("quitter")
+    pub = node.create_publisher(Int32, "stop_me", 10)
+    got: list[int] = []
+    sub = node.create_subscription(Int32, "stop_me", lambda m: got.append(m.data), 10)
+    assert spin_until(node, lambda: bool(got), 5.0, each=lambda: pub.publish(Int32(data=1)))
+
+    assert node.destroy_subscription(sub)
+    spin_for(node, 0.1)
+    count = len(got)
+    for _ in range(5):
+        pub.publish(Int32(data=2))
+        spin_for(node, 0.05)
+    assert len(got) == count
+    assert 2 not in got
+
+
+MISMATCHED = """
+import rosl
+from std_msgs.msg import Int32
+
+rosl.init()
+node = rosl.Node("int_talker")
+pub = node.create_publisher(Int32, "mixed", 10)
+node.create_timer(0.05, lambda: pub.publish(Int32(data=7)))
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def test_a_message_of_another_type_is_dropped_with_one_warning_and_never_misdecoded(
+    ros, spawn, capfd
+):
+    from std_msgs.msg import String
+
+    child = spawn(MISMATCHED)
+    child.expect("^ready$")
+    node = ros.Node("str_listener")
+    got: list[str] = []
+    sub = node.create_subscription(String, "mixed", lambda m: got.append(m.data), 10)
+
+    assert spin_until(node, lambda: sub.mismatched >= 3, 8.0)
+    assert got == []
+    err = capfd.readouterr().err
+    warnings = re.findall(
+        r"^\[WARN\] .*\[str_listener\]: subscription on /mixed expects .*$", err, re.M
+    )
+    assert len(warnings) == 1, err
+    assert "std_msgs/msg/String" in warnings[0]

@@ -74,7 +74,9 @@ def test_several_async_calls_in_flight_each_get_their_own_answer(ros, adder):
     futures = [client.call_async(add_two_ints.Request(a=i, b=1000)) for i in range(5)]
     deadline = time.monotonic() + 8.0
     for future in futures:
-        ros.spin_until_future_complete(node, future, timeout_sec=max(0.0, deadline - time.monotonic()))
+        ros.spin_until_future_complete(
+            node, future, timeout_sec=max(0.0, deadline - time.monotonic())
+        )
 
     assert [f.result().sum if f.done() else None for f in futures] == [
         1000,
@@ -108,7 +110,7 @@ def test_a_call_nobody_answers_raises_a_timeout_error_instead_of_hanging(ros):
     def call() -> None:
         try:
             outcome["result"] = client.call(AddTwoInts.Request(a=1, b=2), timeout_sec=0.5)
-        except Exception as err:  # noqa: BLE001 - inspected below
+        except Exception as err:  # inspected below
             outcome["error"] = err
 
     worker = threading.Thread(target=call, daemon=True)
@@ -203,3 +205,15 @@ def test_call_async_rejects_a_request_of_the_wrong_type(ros):
     client = node.create_client(AddTwoInts, "add_two_ints")
     with pytest.raises(TypeError, match="AddTwoInts"):
         client.call_async(Trigger.Request())
+
+
+def test_spin_until_future_complete_returns_after_its_timeout_if_nothing_completes(ros):
+    node = ros.Node("waiter")
+    future = ros.Future()
+    start = time.monotonic()
+    ros.spin_until_future_complete(node, future, timeout_sec=0.3)
+    assert not future.done()
+    assert 0.25 <= time.monotonic() - start < 5.0
+    future.set_result(3)
+    ros.spin_until_future_complete(node, future, timeout_sec=5.0)
+    assert future.result() == 3
