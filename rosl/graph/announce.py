@@ -87,6 +87,7 @@ class Discovery:
         self._announce_due = 0.0
         self._pending_replies: list[str] = []  # "querier:qid" we still owe an answer
         self._stopping = False
+        self._has_announced = False
         self._started = time.monotonic()
         self._warned = False
         self._thread = threading.Thread(target=self._run, name="rosl-discovery", daemon=True)
@@ -191,7 +192,11 @@ class Discovery:
     def _announce(self, reply_to: list[str]) -> None:
         nodes = tuple(self._describe())
         if not nodes:
+            if self._has_announced:  # the last node went away: leave the graph now
+                self._has_announced = False
+                self._send({"op": "bye", "sender": f"{self.sender:016x}"})
             return
+        self._has_announced = True
         record = ProcessRecord(self.sender, os.getpid(), HOST, nodes, next(self._version))
         known = [f"{s:016x}" for s in self.cache.senders()]
         self._send(

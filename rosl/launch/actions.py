@@ -1,0 +1,430 @@
+"""The core launch actions (launch.actions), event handlers and events."""
+
+from __future__ import annotations
+
+import os
+import shlex
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rosl.launch.description import Action, LaunchDescription, process
+from rosl.launch.errors import LaunchError
+from rosl.launch.substitutions import SomeSubstitutions, perform, resolve_value
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.launch.context import LaunchContext
+    from rosl.launch.supervisor import ProcessEvent
+
+DEFAULT_DESCRIPTION = "no description given"
+
+
+class DeclareLaunchArgument(Action):
+    """Declare a launch argument, with a default and a description."""
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        default_value: SomeSubstitutions = None,
+        description: str = DEFAULT_DESCRIPTION,
+        choices: list[str] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.default_value = default_value
+        self.description = description
+        self.choices = choices
+        self.conditionally_included = False
+
+    def execute(self, context: LaunchContext) -> None:
+        """Take the given value, or the default; a missing one is an error saying how to pass it."""
+        context.declared.append(self)
+        configurations = context.launch_configurations
+        if self.name not in configurations:
+            if self.default_value is None:
+                where = f"{context.current_file}: " if context.current_file else ""
+                raise LaunchError(
+                    f"{where}launch argument '{self.name}' is required ({self.description}); "
+                    f"pass it as {self.name}:=<value>"
+                )
+            configurations[self.name] = perform(context, self.default_value)
+        if self.choices and configurations[self.name] not in self.choices:
+            raise LaunchError(
+                f"launch argument '{self.name}' is '{configurations[self.name]}', but must be "
+                f"one of: {', '.join(self.choices)}"
+            )
+
+
+class SetLaunchConfiguration(Action):
+    """Set a launch configuration."""
+
+    def __init__(self, name: SomeSubstitutions, value: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.value = value
+
+    def execute(self, context: LaunchContext) -> None:
+        """Set it in the current scope."""
+        context.launch_configurations[perform(context, self.name)] = perform(context, self.value)
+
+
+class SetEnvironmentVariable(Action):
+    """Set an environment variable for processes started after it (in this scope)."""
+
+    def __init__(self, name: SomeSubstitutions, value: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.value = value
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record it in the scope's environment."""
+        context.scope.environment[perform(context, self.name)] = perform(context, self.value)
+
+
+class LogInfo(Action):
+    """Print a line from the launch file: ``[INFO] [launch.user]: ...``."""
+
+    def __init__(self, *, msg: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.msg = msg
+
+    def execute(self, context: LaunchContext) -> None:
+        """Log it."""
+        if context.supervisor is not None:
+            context.supervisor.log("INFO", "launch.user", perform(context, self.msg))
+
+
+class GroupAction(Action):
+    """Run actions in their own scope (configurations, namespace, environment)."""
+
+    def __init__(
+        self,
+        actions: list[Any],
+        *,
+        scoped: bool = True,
+        forwarding: bool = True,
+        launch_configurations: dict[str, SomeSubstitutions] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.actions = list(actions)
+        self.scoped = scoped
+        self.forwarding = forwarding
+        self.launch_configurations = launch_configurations or {}
+
+    def execute(self, context: LaunchContext) -> None:
+        """Process the actions inside a scope."""
+        values = {perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()}
+        if self.scoped:
+            context.push(forwarding=self.forwarding, configurations=values)
+        else:
+            context.launch_configurations.update(values)
+        try:
+            process(self.actions, context)
+        finally:
+            if self.scoped:
+                context.pop()
+
+    def children(self) -> list[Any]:
+        """The grouped actions."""
+        return list(self.actions)
+
+
+class IncludeLaunchDescription(Action):
+    """Include another launch file, with launch arguments."""
+
+    def __init__(
+        self,
+        launch_description_source: Any,
+        *,
+        launch_arguments: Any = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.launch_description_source = launch_description_source
+        self.launch_arguments = list(dict(launch_arguments).items()) if isinstance(
+            launch_arguments, dict
+        ) else list(launch_arguments or [])
+
+    def execute(self, context: LaunchContext) -> None:
+        """Load the file and process its description with the given arguments."""
+        from rosl.launch.loader import load_description
+
+        source = self.launch_description_source
+        path = Path(perform(context, getattr(source, "location", source)))
+        for name, value in self.launch_arguments:
+            context.launch_configurations[perform(context, name)] = perform(context, value)
+        description = load_description(path)
+        context.files.append(path)
+        try:
+            process(description.entities, context)
+        finally:
+            context.files.pop()
+
+    def children(self) -> list[Any]:
+        """The included file's entities, when the path needs no launch configuration."""
+        from rosl.launch.loader import load_description
+
+        location = getattr(self.launch_description_source, "location", None)
+        if isinstance(location, (str, Path)) and Path(location).is_file():
+            try:
+                return load_description(Path(location)).entities
+            except LaunchError:
+                return []
+        return []
+
+
+class PythonLaunchDescriptionSource:
+    """A Python launch file to include (launch.launch_description_sources)."""
+
+    def __init__(self, launch_file_path: SomeSubstitutions) -> None:
+        self.location = launch_file_path
+
+
+AnyLaunchDescriptionSource = PythonLaunchDescriptionSource
+FrontendLaunchDescriptionSource = PythonLaunchDescriptionSource
+YAMLLaunchDescriptionSource = PythonLaunchDescriptionSource
+
+
+class ExecuteProcess(Action):
+    """Start a process (launch.actions.ExecuteProcess)."""
+
+    def __init__(  # noqa: PLR0913 - launch's signature
+        self,
+        *,
+        cmd: list[SomeSubstitutions] | SomeSubstitutions,
+        name: SomeSubstitutions = None,
+        cwd: SomeSubstitutions = None,
+        env: dict[str, SomeSubstitutions] | None = None,
+        additional_env: dict[str, SomeSubstitutions] | None = None,
+        shell: bool = False,
+        output: str = "log",
+        respawn: bool | SomeSubstitutions = False,
+        respawn_delay: float | None = None,
+        emulate_tty: bool = False,
+        sigterm_timeout: SomeSubstitutions = None,
+        sigkill_timeout: SomeSubstitutions = None,
+        prefix: SomeSubstitutions = None,
+        on_exit: Any = None,
+        log_cmd: bool = False,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.cmd = cmd
+        self.name = name
+        self.cwd = cwd
+        self.env = env
+        self.additional_env = additional_env
+        self.shell = shell
+        self.output = output
+        self.respawn = respawn
+        self.respawn_delay = respawn_delay or 0.0
+        self.emulate_tty = emulate_tty
+        self.sigterm_timeout = sigterm_timeout
+        self.sigkill_timeout = sigkill_timeout
+        self.prefix = prefix
+        self.on_exit = on_exit
+        del log_cmd
+
+    def command(self, context: LaunchContext) -> list[str]:
+        """The resolved command line."""
+        parts = self.cmd if isinstance(self.cmd, list) else [self.cmd]
+        argv = [perform(context, part) for part in parts]
+        if self.shell:
+            return ["/bin/sh", "-c", " ".join(argv)]
+        return argv
+
+    def base_name(self, context: LaunchContext, argv: list[str]) -> str:
+        """The name shown as ``[name-N]``."""
+        if self.name is not None:
+            return perform(context, self.name)
+        return os.path.basename(argv[0]) if argv else "process"
+
+    def environment(self, context: LaunchContext) -> dict[str, str]:
+        """The environment the process starts with."""
+        if self.env is not None:
+            env = {perform(context, k): perform(context, v) for k, v in self.env.items()}
+        else:
+            env = {**os.environ, **context.scope.environment}
+        for key, value in (self.additional_env or {}).items():
+            env[perform(context, key)] = perform(context, value)
+        return env
+
+    def execute(self, context: LaunchContext) -> None:
+        """Hand the process to the supervisor."""
+        from rosl.launch.supervisor import ProcessSpec
+
+        argv = self.command(context)
+        prefix = perform(context, self.prefix) if self.prefix is not None else ""
+        spec = ProcessSpec(
+            name=self.base_name(context, argv),
+            cmd=[*shlex.split(prefix), *argv],
+            env=self.environment(context),
+            cwd=perform(context, self.cwd) if self.cwd is not None else None,
+            output=str(perform(context, self.output)),
+            respawn=_flag(context, self.respawn),
+            respawn_delay=float(self.respawn_delay),
+            emulate_tty=self.emulate_tty,
+            sigterm_timeout=_seconds(context, self.sigterm_timeout, "sigterm_timeout"),
+            sigkill_timeout=_seconds(context, self.sigkill_timeout, "sigkill_timeout"),
+            details=self.details(context),
+        )
+        if context.supervisor is not None:
+            context.supervisor.start(spec, self, context)
+
+    def details(self, context: LaunchContext) -> dict[str, Any]:
+        """What ``--print`` shows besides the command line."""
+        return {}
+
+
+def _flag(context: LaunchContext, value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    return perform(context, value).strip().lower() in ("true", "1")
+
+
+def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
+    text = perform(context, value) if value is not None else context.launch_configurations.get(
+        configuration, "5"
+    )
+    try:
+        return float(text)
+    except ValueError:
+        raise LaunchError(f"{configuration} must be a number of seconds, not '{text}'") from None
+
+
+class TimerAction(Action):
+    """Run actions after a delay."""
+
+    def __init__(self, *, period: float | SomeSubstitutions, actions: list[Any], **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.period = period
+        self.actions = list(actions)
+
+    def execute(self, context: LaunchContext) -> None:
+        """Schedule the actions."""
+        seconds = float(perform(context, self.period)) if not isinstance(self.period, (int, float)) else self.period
+        if context.supervisor is not None:
+            context.supervisor.call_later(seconds, lambda: process(self.actions, context))
+
+    def children(self) -> list[Any]:
+        """The delayed actions."""
+        return list(self.actions)
+
+
+class OpaqueFunction(Action):
+    """Call a function with the launch context; it may return more actions."""
+
+    def __init__(
+        self,
+        *,
+        function: Callable[..., Any],
+        args: list[Any] | None = None,
+        kwargs: dict[str, Any] | None = None,
+        **rest: Any,
+    ) -> None:
+        super().__init__(**rest)
+        self.function = function
+        self.args = args or []
+        self.kwargs = kwargs or {}
+
+    def execute(self, context: LaunchContext) -> list[Any] | None:
+        """Call the function."""
+        result = self.function(context, *self.args, **self.kwargs)
+        return list(result) if result else None
+
+
+class Shutdown(Action):
+    """Shut the whole launch down (launch.actions.Shutdown, and the Shutdown event)."""
+
+    def __init__(self, *, reason: str = "shutdown requested", **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.reason = reason
+
+    def execute(self, context: LaunchContext) -> None:
+        """Ask the supervisor to stop everything."""
+        if context.supervisor is not None:
+            context.supervisor.shutdown(self.reason)
+
+
+class EmitEvent(Action):
+    """Emit an event; rosl understands ``Shutdown``."""
+
+    def __init__(self, *, event: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event = event
+
+    def execute(self, context: LaunchContext) -> list[Any] | None:
+        """Act on the event."""
+        if isinstance(self.event, Shutdown):
+            return [self.event]
+        raise LaunchError(f"EmitEvent: rosl only supports Shutdown events, not {type(self.event).__name__}")
+
+
+class EventHandler:
+    """Base of OnProcessStart / OnProcessExit."""
+
+    event_kind = ""
+
+    def __init__(self, *, target_action: Any = None, handler: Any = None) -> None:
+        self.target_action = target_action
+        self.handler = handler
+
+    def matches(self, event: ProcessEvent) -> bool:
+        """Whether this handler reacts to ``event``."""
+        return event.kind == self.event_kind and (
+            self.target_action is None or self.target_action is event.action
+        )
+
+    def entities(self, event: ProcessEvent, context: LaunchContext) -> list[Any]:
+        """The actions to run for ``event``."""
+        reaction = self.handler
+        if callable(reaction) and not hasattr(reaction, "visit"):
+            reaction = reaction(event, context)
+        if reaction is None:
+            return []
+        return list(reaction) if isinstance(reaction, (list, tuple)) else [reaction]
+
+
+class OnProcessStart(EventHandler):
+    """React when a process starts."""
+
+    event_kind = "start"
+
+    def __init__(self, *, target_action: Any = None, on_start: Any = None) -> None:
+        super().__init__(target_action=target_action, handler=on_start)
+
+
+class OnProcessExit(EventHandler):
+    """React when a process exits."""
+
+    event_kind = "exit"
+
+    def __init__(self, *, target_action: Any = None, on_exit: Any = None) -> None:
+        super().__init__(target_action=target_action, handler=on_exit)
+
+
+class RegisterEventHandler(Action):
+    """Register an OnProcessStart/OnProcessExit handler."""
+
+    def __init__(self, event_handler: EventHandler, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event_handler = event_handler
+
+    def execute(self, context: LaunchContext) -> None:
+        """Give the handler to the supervisor."""
+        if context.supervisor is not None:
+            context.supervisor.add_handler(self.event_handler, context)
+
+
+def launch_description_from(entities: list[Any]) -> LaunchDescription:
+    """Wrap a list in a LaunchDescription."""
+    return LaunchDescription(entities)
+
+
+def resolve_parameter_value(context: LaunchContext, value: Any) -> Any:
+    """Resolve substitutions inside a parameter value."""
+    return resolve_value(context, value)

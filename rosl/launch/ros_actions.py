@@ -1,0 +1,184 @@
+"""launch_ros's actions: Node, PushRosNamespace, SetParameter, SetRemap.
+
+A Node becomes ``<executable> [arguments] --ros-args -r __node:=NAME -r __ns:=NS
+--params-file FILE -r from:=to ...`` — the same ``--ros-args`` a user could type. Parameter
+dicts are written to a YAML file in the launch's log folder, as ROS 2 does.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rosl.launch.actions import ExecuteProcess
+from rosl.launch.description import Action
+from rosl.launch.errors import LaunchError
+from rosl.launch.substitutions import SomeSubstitutions, Substitution, perform, resolve_value
+
+if TYPE_CHECKING:
+    from rosl.launch.context import LaunchContext
+
+
+class Node(ExecuteProcess):
+    """Start a package's executable as a ROS node (launch_ros.actions.Node)."""
+
+    def __init__(  # noqa: PLR0913 - launch_ros's signature
+        self,
+        *,
+        executable: SomeSubstitutions,
+        package: SomeSubstitutions = None,
+        name: SomeSubstitutions = None,
+        namespace: SomeSubstitutions = None,
+        exec_name: SomeSubstitutions = None,
+        parameters: list[Any] | None = None,
+        remappings: list[tuple[SomeSubstitutions, SomeSubstitutions]] | None = None,
+        ros_arguments: list[SomeSubstitutions] | None = None,
+        arguments: list[SomeSubstitutions] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(cmd=[], **kwargs)
+        self.package = package
+        self.executable = executable
+        self.node_name = name
+        self.node_namespace = namespace
+        self.exec_name = exec_name
+        self.parameters = list(parameters or [])
+        self.remappings = list(remappings or [])
+        self.ros_arguments = list(ros_arguments or [])
+        self.arguments = list(arguments or [])
+
+    def _namespace(self, context: LaunchContext) -> str:
+        scoped = context.scope.namespace
+        own = perform(context, self.node_namespace) if self.node_namespace is not None else ""
+        if own.startswith("/"):
+            return own.rstrip("/") or "/"
+        joined = "/".join(part for part in (scoped.strip("/"), own.strip("/")) if part)
+        return "/" + joined if joined else ""
+
+    def _parameter_arguments(self, context: LaunchContext) -> tuple[list[str], dict[str, Any]]:
+        values: dict[str, Any] = {}
+        for name, value in context.scope.parameters:
+            values[perform(context, name)] = resolve_value(context, value)
+        files: list[str] = []
+        for entry in self.parameters:
+            if isinstance(entry, dict):
+                for key, value in entry.items():
+                    values[perform(context, key)] = resolve_value(context, value)
+            elif isinstance(entry, (str, Path, Substitution, list, tuple)):
+                path = Path(perform(context, entry) if not isinstance(entry, Path) else entry)
+                if not path.is_file():
+                    raise LaunchError(f"parameter file {path} (for {self._label(context)}) does not exist")
+                files.append(str(path))
+            else:
+                raise LaunchError(
+                    f"parameters of {self._label(context)} must be dicts or YAML file paths, "
+                    f"not {type(entry).__name__}"
+                )
+        args: list[str] = []
+        if values and context.supervisor is not None:
+            args += ["--params-file", str(context.supervisor.parameter_file(self._label(context), values))]
+        for path in files:
+            args += ["--params-file", path]
+        return args, values
+
+    def _label(self, context: LaunchContext) -> str:
+        if self.node_name is not None:
+            return perform(context, self.node_name)
+        return perform(context, self.executable)
+
+    def command(self, context: LaunchContext) -> list[str]:
+        """The command line of the node, with its ``--ros-args``."""
+        from rosl.pkg.errors import PackageError
+        from rosl.pkg.executables import command_line, find_executable
+
+        if self.package is None:
+            raise LaunchError(f"Node(executable='{perform(context, self.executable)}') needs package=")
+        package = perform(context, self.package)
+        executable = perform(context, self.executable)
+        try:
+            found = find_executable(package, executable)
+        except PackageError as err:
+            raise LaunchError(str(err)) from None
+        ros: list[str] = []
+        if self.node_name is not None:
+            ros += ["-r", f"__node:={perform(context, self.node_name)}"]
+        namespace = self._namespace(context)
+        if namespace:
+            ros += ["-r", f"__ns:={namespace}"]
+        params, _ = self._parameter_arguments(context)
+        ros += params
+        for source, target in [*context.scope.remappings, *self.remappings]:
+            ros += ["-r", f"{perform(context, source)}:={perform(context, target)}"]
+        ros += [perform(context, a) for a in self.ros_arguments]
+        user = [perform(context, a) for a in self.arguments]
+        return command_line(found, [*user, *(["--ros-args", *ros] if ros else [])])
+
+    def base_name(self, context: LaunchContext, argv: list[str]) -> str:
+        """``[executable-N]`` as ROS 2 names a node's output."""
+        if self.exec_name is not None:
+            return perform(context, self.exec_name)
+        return perform(context, self.executable)
+
+    def details(self, context: LaunchContext) -> dict[str, Any]:
+        """Package, executable, name, namespace, parameters and remaps, for ``--print``."""
+        _, values = self._parameter_arguments_preview(context)
+        return {
+            "package": perform(context, self.package),
+            "executable": perform(context, self.executable),
+            "name": perform(context, self.node_name) if self.node_name is not None else None,
+            "namespace": self._namespace(context) or "/",
+            "parameters": values,
+            "remappings": [
+                (perform(context, s), perform(context, t))
+                for s, t in [*context.scope.remappings, *self.remappings]
+            ],
+        }
+
+    def _parameter_arguments_preview(self, context: LaunchContext) -> tuple[list[str], dict[str, Any]]:
+        values: dict[str, Any] = {}
+        for name, value in context.scope.parameters:
+            values[perform(context, name)] = resolve_value(context, value)
+        for entry in self.parameters:
+            if isinstance(entry, dict):
+                values.update({perform(context, k): resolve_value(context, v) for k, v in entry.items()})
+            else:
+                values[f"(file) {perform(context, entry) if not isinstance(entry, Path) else entry}"] = "..."
+        return [], values
+
+
+class PushRosNamespace(Action):
+    """Put the nodes after it (in this scope) under a namespace."""
+
+    def __init__(self, namespace: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.namespace = namespace
+
+    def execute(self, context: LaunchContext) -> None:
+        """Push the namespace on the current scope."""
+        context.push_namespace(perform(context, self.namespace))
+
+
+class SetParameter(Action):
+    """Give a parameter to every node started after it (in this scope)."""
+
+    def __init__(self, name: SomeSubstitutions, value: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.value = value
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record it on the current scope."""
+        context.scope.parameters.append((self.name, self.value))
+
+
+class SetRemap(Action):
+    """Remap a name for every node started after it (in this scope)."""
+
+    def __init__(self, src: SomeSubstitutions, dst: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.src = src
+        self.dst = dst
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record it on the current scope."""
+        context.scope.remappings.append((self.src, self.dst))

@@ -1,0 +1,369 @@
+"""Running the processes of a launch: output, events, respawn, and a clean shutdown.
+
+Every child runs in its own process group (a terminal's Ctrl-C reaches only the launcher,
+which forwards it once) with a parent-death signal, so children die with the launcher even
+when it is SIGKILLed. On shutdown each child gets SIGINT, then SIGTERM after
+``sigterm_timeout``, then SIGKILL after ``sigkill_timeout`` (ROS 2's defaults: 5 s each).
+Output lines are prefixed ``[name-N]`` (coloured on a terminal, plain when piped or with
+NO_COLOR) and routed by ``output`` as ROS 2 does: 'screen', 'log' (stdout to the launch log,
+stderr to both), 'both'.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import datetime
+import heapq
+import itertools
+import os
+import selectors
+import signal
+import socket
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any
+
+from rosl.launch.errors import LaunchError
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.launch.context import LaunchContext
+
+_COLORS = ["\033[32m", "\033[34m", "\033[35m", "\033[36m", "\033[33m", "\033[92m", "\033[94m"]
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:  # runs in the child between fork and exec
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):
+        pass
+
+
+@dataclass(slots=True)
+class ProcessSpec:
+    """What to start, resolved from a launch action."""
+
+    name: str
+    cmd: list[str]
+    env: dict[str, str]
+    cwd: str | None = None
+    output: str = "log"
+    respawn: bool = False
+    respawn_delay: float = 0.0
+    emulate_tty: bool = False
+    sigterm_timeout: float = 5.0
+    sigkill_timeout: float = 5.0
+    details: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(slots=True)
+class ProcessEvent:
+    """A process started or exited (what event handlers see)."""
+
+    kind: str  # "start" | "exit"
+    action: Any
+    name: str
+    pid: int
+    returncode: int | None = None
+    cmd: list[str] = field(default_factory=list)
+
+
+@dataclass(slots=True)
+class Running:
+    """A started process and its output buffers."""
+
+    spec: ProcessSpec
+    label: str
+    action: Any
+    context: LaunchContext
+    popen: subprocess.Popen[bytes]
+    partial: dict[int, bytes] = field(default_factory=dict)
+    signals: list[tuple[float, int]] = field(default_factory=list)  # (sent at, signal)
+    stopping: bool = False
+
+
+class Supervisor:
+    """Starts, watches and stops the processes of one launch."""
+
+    def __init__(
+        self,
+        *,
+        dry_run: bool = False,
+        log_dir: Path | None = None,
+        stream: IO[str] | None = None,
+        color: bool | None = None,
+    ) -> None:
+        self.dry_run = dry_run
+        self.stream = stream or sys.stdout
+        self.color = self.stream.isatty() and not os.environ.get("NO_COLOR") if color is None else color
+        self.log_dir = log_dir or _default_log_dir()
+        self.planned: list[ProcessSpec] = []
+        self.failed: list[str] = []
+        self.started = 0
+        self._counter = itertools.count(1)
+        self._running: list[Running] = []
+        self._handlers: list[tuple[Any, LaunchContext]] = []
+        self._timers: list[tuple[float, int, Callable[[], None]]] = []
+        self._timer_ids = itertools.count()
+        self._respawns: list[tuple[float, int, ProcessSpec, Any, LaunchContext, str]] = []
+        self._selector = selectors.DefaultSelector()
+        self._shutdown_reason: str | None = None
+        self._log_file: IO[str] | None = None
+        self._interrupts = 0
+
+    # --- logging -----------------------------------------------------------------------------
+
+    def _log_handle(self) -> IO[str] | None:
+        if self._log_file is None and not self.dry_run:
+            try:
+                self.log_dir.mkdir(parents=True, exist_ok=True)
+                self._log_file = (self.log_dir / "launch.log").open("a", encoding="utf-8")
+            except OSError:
+                return None
+        return self._log_file
+
+    def log(self, level: str, name: str, text: str) -> None:
+        """Print ``[LEVEL] [name]: text`` (and keep it in launch.log)."""
+        line = f"[{level}] [{name}]: {text}"
+        self._write_screen(line)
+        self._write_log(line)
+
+    def _write_screen(self, line: str) -> None:
+        try:
+            self.stream.write(line + "\n")
+            self.stream.flush()
+        except (OSError, ValueError):
+            pass
+
+    def _write_log(self, line: str) -> None:
+        handle = self._log_handle()
+        if handle is not None:
+            handle.write(f"{time.time():.7f} {line}\n")
+            handle.flush()
+
+    def parameter_file(self, label: str, values: dict[str, Any]) -> Path:
+        """Write a node's parameters as a ROS 2 parameter file; return its path."""
+        import yaml
+
+        folder = self.log_dir / "params"
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{label.replace('/', '_')}-{next(self._counter)}.yaml"
+        path.write_text(yaml.safe_dump({"/**": {"ros__parameters": values}}), encoding="utf-8")
+        return path
+
+    # --- starting ----------------------------------------------------------------------------
+
+    def start(self, spec: ProcessSpec, action: Any, context: LaunchContext, label: str | None = None) -> None:
+        """Start a process (or, in a dry run, just record it)."""
+        self.planned.append(spec)
+        if self.dry_run or self._shutdown_reason is not None:
+            return
+        label = label or f"{spec.name}-{next(self._counter)}"
+        env = {**spec.env, "PYTHONUNBUFFERED": "1"}
+        if spec.emulate_tty and self.color:
+            env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
+        try:
+            popen = subprocess.Popen(
+                spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+                preexec_fn=_die_with_parent,  # noqa: PLW1509 - the launcher has no threads
+            )  # fmt: skip
+        except OSError as err:
+            self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
+            self.failed.append(label)
+            return
+        self.started += 1
+        running = Running(spec, label, action, context, popen)
+        self._running.append(running)
+        for pipe in (popen.stdout, popen.stderr):
+            assert pipe is not None
+            os.set_blocking(pipe.fileno(), False)
+            self._selector.register(pipe, selectors.EVENT_READ, running)
+        self.log("INFO", label, f"process started with pid [{popen.pid}]")
+        self._emit(ProcessEvent("start", action, label, popen.pid, None, spec.cmd), context)
+
+    def call_later(self, seconds: float, function: Callable[[], None]) -> None:
+        """Run ``function`` after ``seconds`` (TimerAction)."""
+        heapq.heappush(self._timers, (time.monotonic() + seconds, next(self._timer_ids), function))
+
+    def add_handler(self, handler: Any, context: LaunchContext) -> None:
+        """Register an OnProcessStart/OnProcessExit handler."""
+        self._handlers.append((handler, context))
+
+    def _emit(self, event: ProcessEvent, context: LaunchContext) -> None:
+        from rosl.launch.description import process
+
+        for handler, handler_context in list(self._handlers):
+            if handler.matches(event):
+                process(handler.entities(event, handler_context or context), handler_context)
+
+    # --- the loop ----------------------------------------------------------------------------
+
+    def shutdown(self, reason: str) -> None:
+        """Stop every process (SIGINT, then escalation) and start nothing more."""
+        if self._shutdown_reason is not None:
+            return
+        self._shutdown_reason = reason
+        self._timers.clear()
+        self._respawns.clear()
+        for running in self._running:
+            self._signal(running, signal.SIGINT)
+
+    def _signal(self, running: Running, signum: int) -> None:
+        running.stopping = True
+        running.signals.append((time.monotonic(), signum))
+        try:
+            os.killpg(running.popen.pid, signum)
+        except (ProcessLookupError, PermissionError):
+            try:
+                running.popen.send_signal(signum)
+            except ProcessLookupError:
+                pass
+
+    def _on_signal(self, signum: int, frame: Any) -> None:
+        self._interrupts += 1
+        name = "SIGINT" if signum == signal.SIGINT else "SIGTERM"
+        if self._interrupts == 1:
+            why = "user interrupted with ctrl-c (SIGINT)" if signum == signal.SIGINT else f"signal {name} received"
+            self.log("WARNING", "launch", why)
+            self.shutdown(why)
+        else:  # again: do not wait for the grace periods
+            for running in self._running:
+                self._signal(running, signal.SIGKILL if self._interrupts > 2 else signal.SIGTERM)
+
+    def run(self) -> int:
+        """Supervise until every process is gone; return the launch's exit status."""
+        previous = {s: signal.signal(s, self._on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            while self._running or (self._shutdown_reason is None and (self._timers or self._respawns)):
+                self._step()
+        finally:
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+            self.kill_all()
+            if self._log_file is not None:
+                self._log_file.close()
+        return 1 if self.failed else 0
+
+    def _step(self) -> None:
+        now = time.monotonic()
+        wait = 0.1
+        if self._timers:
+            wait = min(wait, max(0.0, self._timers[0][0] - now))
+        for key, _ in self._selector.select(wait):
+            self._read(key.fileobj, key.data)  # type: ignore[arg-type]
+        now = time.monotonic()
+        while self._timers and self._timers[0][0] <= now and self._shutdown_reason is None:
+            _, _, function = heapq.heappop(self._timers)
+            function()
+        for entry in [r for r in self._respawns if r[0] <= now]:
+            self._respawns.remove(entry)
+            _, _, spec, action, context, label = entry
+            self.start(spec, action, context, label)
+        for running in list(self._running):
+            if running.popen.poll() is not None:
+                self._finish(running)
+            elif running.stopping:
+                self._escalate(running, now)
+
+    def _escalate(self, running: Running, now: float) -> None:
+        sent_at, last = running.signals[-1]
+        timeout = running.spec.sigterm_timeout if last == signal.SIGINT else running.spec.sigkill_timeout
+        if last == signal.SIGKILL or now - sent_at < timeout:
+            return
+        following = signal.SIGTERM if last == signal.SIGINT else signal.SIGKILL
+        self.log(
+            "ERROR", running.label,
+            f"process[{running.label}] failed to terminate '{timeout}' seconds after receiving "
+            f"'{signal.Signals(last).name}', escalating to '{signal.Signals(following).name}'",
+        )  # fmt: skip
+        self._signal(running, following)
+
+    def _read(self, pipe: IO[bytes], running: Running) -> None:
+        try:
+            chunk = os.read(pipe.fileno(), 65536)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            chunk = b""
+        stderr = pipe is running.popen.stderr
+        key = 2 if stderr else 1
+        if not chunk:
+            self._selector.unregister(pipe)
+            rest = running.partial.pop(key, b"")
+            if rest:
+                self._route(running, rest, stderr)
+            return
+        data = running.partial.pop(key, b"") + chunk
+        *lines, rest = data.split(b"\n")
+        if rest:
+            running.partial[key] = rest
+        for line in lines:
+            self._route(running, line, stderr)
+
+    def _route(self, running: Running, raw: bytes, stderr: bool) -> None:
+        text = raw.decode("utf-8", "replace").rstrip("\r")
+        output = running.spec.output
+        to_screen = output in ("screen", "both") or (output == "log" and stderr)
+        to_log = output in ("log", "both")
+        prefix = f"[{running.label}]"
+        if to_screen:
+            shown = f"{self._colour(running.spec.name)}{prefix}\033[0m" if self.color else prefix
+            self._write_screen(f"{shown} {text}")
+        if to_log:
+            self._write_log(f"{prefix} {text}")
+
+    def _colour(self, name: str) -> str:
+        return _COLORS[sum(name.encode()) % len(_COLORS)]
+
+    def _finish(self, running: Running) -> None:
+        for pipe in (running.popen.stdout, running.popen.stderr):
+            if pipe is not None:
+                while True:
+                    try:
+                        self._selector.get_key(pipe)
+                    except KeyError:
+                        break
+                    self._read(pipe, running)
+        self._running.remove(running)
+        code = running.popen.returncode
+        pid = running.popen.pid
+        if code == 0:
+            self.log("INFO", running.label, f"process has finished cleanly [pid {pid}]")
+        else:
+            cmd = " ".join(running.spec.cmd)
+            self.log("ERROR", running.label, f"process has died [pid {pid}, exit code {code}, cmd '{cmd}'].")
+            if not running.stopping:
+                self.failed.append(running.label)
+        self._emit(ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd), running.context)
+        if running.spec.respawn and self._shutdown_reason is None:
+            self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
+                                   running.action, running.context, running.label))  # fmt: skip
+
+    def kill_all(self) -> None:
+        """Make sure nothing is left running (SIGKILL to every process group)."""
+        for running in list(self._running):
+            self._signal(running, signal.SIGKILL)
+            try:
+                running.popen.wait(timeout=2)
+            except subprocess.TimeoutExpired:
+                pass
+        self._running.clear()
+
+
+def _default_log_dir() -> Path:
+    base = os.environ.get("ROSL_LOG_DIR") or os.path.join(os.path.expanduser("~"), ".rosl", "log")
+    stamp = datetime.datetime.now().strftime("%Y-%m-%d-%H-%M-%S-%f")
+    return Path(base) / f"{stamp}-{socket.gethostname()}-{os.getpid()}"
+
+
+def check_output(value: str) -> str:
+    """Validate an ``output=`` value."""
+    if value not in ("screen", "log", "both", "own_log", "full"):
+        raise LaunchError(f"output='{value}' is not one of 'screen', 'log', 'both'")
+    return value
