@@ -19,6 +19,8 @@ if TYPE_CHECKING:
 
 ALIASES: dict[str, str] = {
     "rclpy": "rosl.compat.rclpy",
+    "launch": "rosl.compat.launch",
+    "launch_ros": "rosl.compat.launch_ros",
 }
 
 
@@ -32,7 +34,7 @@ class _AliasLoader(importlib.abc.Loader):
     def exec_module(self, module: types.ModuleType) -> None:
         source = importlib.import_module(self.target)
         for key, value in vars(source).items():
-            if not key.startswith("__") or key in ("__all__", "__doc__"):
+            if not key.startswith("__") or key in ("__all__", "__doc__", "__getattr__"):
                 setattr(module, key, value)
 
 

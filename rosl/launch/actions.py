@@ -117,7 +117,9 @@ class GroupAction(Action):
 
     def execute(self, context: LaunchContext) -> None:
         """Process the actions inside a scope."""
-        values = {perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()}
+        values = {
+            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
+        }
         if self.scoped:
             context.push(forwarding=self.forwarding, configurations=values)
         else:
@@ -145,9 +147,11 @@ class IncludeLaunchDescription(Action):
     ) -> None:
         super().__init__(**kwargs)
         self.launch_description_source = launch_description_source
-        self.launch_arguments = list(dict(launch_arguments).items()) if isinstance(
-            launch_arguments, dict
-        ) else list(launch_arguments or [])
+        self.launch_arguments = (
+            list(dict(launch_arguments).items())
+            if isinstance(launch_arguments, dict)
+            else list(launch_arguments or [])
+        )
 
     def execute(self, context: LaunchContext) -> None:
         """Load the file and process its description with the given arguments."""
@@ -192,7 +196,7 @@ YAMLLaunchDescriptionSource = PythonLaunchDescriptionSource
 class ExecuteProcess(Action):
     """Start a process (launch.actions.ExecuteProcess)."""
 
-    def __init__(  # noqa: PLR0913 - launch's signature
+    def __init__(
         self,
         *,
         cmd: list[SomeSubstitutions] | SomeSubstitutions,
@@ -287,8 +291,10 @@ def _flag(context: LaunchContext, value: Any) -> bool:
 
 
 def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
-    text = perform(context, value) if value is not None else context.launch_configurations.get(
-        configuration, "5"
+    text = (
+        perform(context, value)
+        if value is not None
+        else context.launch_configurations.get(configuration, "5")
     )
     try:
         return float(text)
@@ -299,14 +305,20 @@ def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
 class TimerAction(Action):
     """Run actions after a delay."""
 
-    def __init__(self, *, period: float | SomeSubstitutions, actions: list[Any], **kwargs: Any) -> None:
+    def __init__(
+        self, *, period: float | SomeSubstitutions, actions: list[Any], **kwargs: Any
+    ) -> None:
         super().__init__(**kwargs)
         self.period = period
         self.actions = list(actions)
 
     def execute(self, context: LaunchContext) -> None:
         """Schedule the actions."""
-        seconds = float(perform(context, self.period)) if not isinstance(self.period, (int, float)) else self.period
+        seconds = (
+            float(perform(context, self.period))
+            if not isinstance(self.period, (int, float))
+            else self.period
+        )
         if context.supervisor is not None:
             context.supervisor.call_later(seconds, lambda: process(self.actions, context))
 
@@ -361,7 +373,9 @@ class EmitEvent(Action):
         """Act on the event."""
         if isinstance(self.event, Shutdown):
             return [self.event]
-        raise LaunchError(f"EmitEvent: rosl only supports Shutdown events, not {type(self.event).__name__}")
+        raise LaunchError(
+            f"EmitEvent: rosl only supports Shutdown events, not {type(self.event).__name__}"
+        )
 
 
 class EventHandler:

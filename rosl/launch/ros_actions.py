@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 class Node(ExecuteProcess):
     """Start a package's executable as a ROS node (launch_ros.actions.Node)."""
 
-    def __init__(  # noqa: PLR0913 - launch_ros's signature
+    def __init__(
         self,
         *,
         executable: SomeSubstitutions,
@@ -67,7 +67,9 @@ class Node(ExecuteProcess):
             elif isinstance(entry, (str, Path, Substitution, list, tuple)):
                 path = Path(perform(context, entry) if not isinstance(entry, Path) else entry)
                 if not path.is_file():
-                    raise LaunchError(f"parameter file {path} (for {self._label(context)}) does not exist")
+                    raise LaunchError(
+                        f"parameter file {path} (for {self._label(context)}) does not exist"
+                    )
                 files.append(str(path))
             else:
                 raise LaunchError(
@@ -76,7 +78,10 @@ class Node(ExecuteProcess):
                 )
         args: list[str] = []
         if values and context.supervisor is not None:
-            args += ["--params-file", str(context.supervisor.parameter_file(self._label(context), values))]
+            args += [
+                "--params-file",
+                str(context.supervisor.parameter_file(self._label(context), values)),
+            ]
         for path in files:
             args += ["--params-file", path]
         return args, values
@@ -92,7 +97,9 @@ class Node(ExecuteProcess):
         from rosl.pkg.executables import command_line, find_executable
 
         if self.package is None:
-            raise LaunchError(f"Node(executable='{perform(context, self.executable)}') needs package=")
+            raise LaunchError(
+                f"Node(executable='{perform(context, self.executable)}') needs package="
+            )
         package = perform(context, self.package)
         executable = perform(context, self.executable)
         try:
@@ -134,15 +141,21 @@ class Node(ExecuteProcess):
             ],
         }
 
-    def _parameter_arguments_preview(self, context: LaunchContext) -> tuple[list[str], dict[str, Any]]:
+    def _parameter_arguments_preview(
+        self, context: LaunchContext
+    ) -> tuple[list[str], dict[str, Any]]:
         values: dict[str, Any] = {}
         for name, value in context.scope.parameters:
             values[perform(context, name)] = resolve_value(context, value)
         for entry in self.parameters:
             if isinstance(entry, dict):
-                values.update({perform(context, k): resolve_value(context, v) for k, v in entry.items()})
+                values.update(
+                    {perform(context, k): resolve_value(context, v) for k, v in entry.items()}
+                )
             else:
-                values[f"(file) {perform(context, entry) if not isinstance(entry, Path) else entry}"] = "..."
+                values[
+                    f"(file) {perform(context, entry) if not isinstance(entry, Path) else entry}"
+                ] = "..."
         return [], values
 
 

@@ -11,6 +11,7 @@ stderr to both), 'both'.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import datetime
 import heapq
@@ -38,10 +39,8 @@ _PR_SET_PDEATHSIG = 1
 
 
 def _die_with_parent() -> None:  # runs in the child between fork and exec
-    try:
+    with contextlib.suppress(OSError, AttributeError):
         ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-    except (OSError, AttributeError):
-        pass
 
 
 @dataclass(slots=True)
@@ -100,12 +99,15 @@ class Supervisor:
     ) -> None:
         self.dry_run = dry_run
         self.stream = stream or sys.stdout
-        self.color = self.stream.isatty() and not os.environ.get("NO_COLOR") if color is None else color
+        self.color = (
+            self.stream.isatty() and not os.environ.get("NO_COLOR") if color is None else color
+        )
         self.log_dir = log_dir or _default_log_dir()
         self.planned: list[ProcessSpec] = []
         self.failed: list[str] = []
         self.started = 0
         self._counter = itertools.count(1)
+        self._param_files = itertools.count(1)
         self._running: list[Running] = []
         self._handlers: list[tuple[Any, LaunchContext]] = []
         self._timers: list[tuple[float, int, Callable[[], None]]] = []
@@ -152,13 +154,15 @@ class Supervisor:
 
         folder = self.log_dir / "params"
         folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{label.replace('/', '_')}-{next(self._counter)}.yaml"
+        path = folder / f"{label.replace('/', '_')}-{next(self._param_files)}.yaml"
         path.write_text(yaml.safe_dump({"/**": {"ros__parameters": values}}), encoding="utf-8")
         return path
 
     # --- starting ----------------------------------------------------------------------------
 
-    def start(self, spec: ProcessSpec, action: Any, context: LaunchContext, label: str | None = None) -> None:
+    def start(
+        self, spec: ProcessSpec, action: Any, context: LaunchContext, label: str | None = None
+    ) -> None:
         """Start a process (or, in a dry run, just record it)."""
         self.planned.append(spec)
         if self.dry_run or self._shutdown_reason is not None:
@@ -171,7 +175,7 @@ class Supervisor:
             popen = subprocess.Popen(
                 spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
-                preexec_fn=_die_with_parent,  # noqa: PLW1509 - the launcher has no threads
+                preexec_fn=_die_with_parent,
             )  # fmt: skip
         except OSError as err:
             self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
@@ -220,16 +224,18 @@ class Supervisor:
         try:
             os.killpg(running.popen.pid, signum)
         except (ProcessLookupError, PermissionError):
-            try:
+            with contextlib.suppress(ProcessLookupError):
                 running.popen.send_signal(signum)
-            except ProcessLookupError:
-                pass
 
     def _on_signal(self, signum: int, frame: Any) -> None:
         self._interrupts += 1
         name = "SIGINT" if signum == signal.SIGINT else "SIGTERM"
         if self._interrupts == 1:
-            why = "user interrupted with ctrl-c (SIGINT)" if signum == signal.SIGINT else f"signal {name} received"
+            why = (
+                "user interrupted with ctrl-c (SIGINT)"
+                if signum == signal.SIGINT
+                else f"signal {name} received"
+            )
             self.log("WARNING", "launch", why)
             self.shutdown(why)
         else:  # again: do not wait for the grace periods
@@ -240,7 +246,9 @@ class Supervisor:
         """Supervise until every process is gone; return the launch's exit status."""
         previous = {s: signal.signal(s, self._on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
         try:
-            while self._running or (self._shutdown_reason is None and (self._timers or self._respawns)):
+            while self._running or (
+                self._shutdown_reason is None and (self._timers or self._respawns)
+            ):
                 self._step()
         finally:
             for sig, handler in previous.items():
@@ -273,7 +281,9 @@ class Supervisor:
 
     def _escalate(self, running: Running, now: float) -> None:
         sent_at, last = running.signals[-1]
-        timeout = running.spec.sigterm_timeout if last == signal.SIGINT else running.spec.sigkill_timeout
+        timeout = (
+            running.spec.sigterm_timeout if last == signal.SIGINT else running.spec.sigkill_timeout
+        )
         if last == signal.SIGKILL or now - sent_at < timeout:
             return
         following = signal.SIGTERM if last == signal.SIGINT else signal.SIGKILL
@@ -337,10 +347,17 @@ class Supervisor:
             self.log("INFO", running.label, f"process has finished cleanly [pid {pid}]")
         else:
             cmd = " ".join(running.spec.cmd)
-            self.log("ERROR", running.label, f"process has died [pid {pid}, exit code {code}, cmd '{cmd}'].")
+            self.log(
+                "ERROR",
+                running.label,
+                f"process has died [pid {pid}, exit code {code}, cmd '{cmd}'].",
+            )
             if not running.stopping:
                 self.failed.append(running.label)
-        self._emit(ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd), running.context)
+        self._emit(
+            ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd),
+            running.context,
+        )
         if running.spec.respawn and self._shutdown_reason is None:
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip
@@ -349,10 +366,8 @@ class Supervisor:
         """Make sure nothing is left running (SIGKILL to every process group)."""
         for running in list(self._running):
             self._signal(running, signal.SIGKILL)
-            try:
+            with contextlib.suppress(subprocess.TimeoutExpired):
                 running.popen.wait(timeout=2)
-            except subprocess.TimeoutExpired:
-                pass
         self._running.clear()
 
 

@@ -98,8 +98,11 @@ class Lines:
         self.closed = False
 
     def _run(self, stream: object) -> None:
-        for line in stream:  # type: ignore[attr-defined]
-            self._queue.put(line.rstrip("\n"))
+        try:
+            for line in stream:  # type: ignore[attr-defined]
+                self._queue.put(line.rstrip("\n"))
+        except (ValueError, OSError):
+            pass  # closed by the processes fixture while we were reading
         self._queue.put(None)
 
     def _pull(self, timeout: float) -> bool:
@@ -144,3 +147,72 @@ def wait_exit(child: subprocess.Popen[str], timeout: float) -> int | None:
             return code
         time.sleep(0.02)
     return child.poll()
+
+
+# --- node snippets shared by the process tests ------------------------------------------------
+
+TALKER = r"""
+import sys
+import rosl
+from std_msgs.msg import String
+
+rosl.init()
+node = rosl.Node(sys.argv[1])
+pub = node.create_publisher(String, sys.argv[2], 10)
+count = 0
+
+def tick():
+    global count
+    count += 1
+    pub.publish(String(data=f"hello {count}"))
+
+node.create_timer(0.01, tick)
+print("up", flush=True)
+rosl.spin(node)
+print("sent", count, flush=True)
+rosl.shutdown()
+"""
+
+LISTENER = r"""
+import sys
+import rosl
+from std_msgs.msg import String
+
+rosl.init()
+node = rosl.Node(sys.argv[1])
+good = bad = 0
+
+def on_message(msg):
+    global good, bad
+    if msg.data.startswith("hello "):
+        good += 1
+        if good % 10 == 0:
+            print("good", good, flush=True)
+    else:
+        bad += 1
+
+node.create_subscription(String, sys.argv[2], on_message, 10)
+print("up", flush=True)
+rosl.spin(node)
+print("final", good, bad, flush=True)
+rosl.shutdown()
+"""
+
+PROBE = r"""
+import sys
+import rosl
+
+rosl.init()
+node = rosl.Node("bus_probe")
+graph = node.participant.graph
+want = set(sys.argv[1:])
+found = graph.wait_for(lambda: want <= {n.fqn for n in graph.nodes()}, 5.0)
+print("nodes", " ".join(sorted(n.fqn for n in graph.nodes())), flush=True)
+print("found" if found else "missing", flush=True)
+rosl.shutdown()
+"""
+
+
+def good_count(lines: list[str]) -> int:
+    """The listener's latest count of valid messages (it prints one line every 10)."""
+    return max((int(x.split()[1]) for x in lines if x.startswith("good ")), default=0)

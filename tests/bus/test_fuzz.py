@@ -20,7 +20,7 @@ from rosl.bus.header import HEADER, HEADER_SIZE, MAGIC, Kind, topic_hash, type_h
 from rosl.bus.multicast import CHANNELS, Addressing, open_receiver
 from rosl.bus.transport import channel_of
 from rosl.graph.announce import DISCOVERY_TOPIC, DISCOVERY_TYPE
-from tests.bus.helpers import Lines, wait_exit
+from tests.bus.helpers import LISTENER, PROBE, TALKER, Lines, good_count, wait_exit
 
 if TYPE_CHECKING:
     import subprocess
@@ -31,67 +31,6 @@ TOPIC = "/fuzz_chatter"
 TALKER_NAME = "fuzz_talker"
 LISTENER_NAME = "fuzz_listener"
 MAX_PAYLOAD = 65000 - HEADER_SIZE
-
-TALKER = r"""
-import sys
-import rosl
-from std_msgs.msg import String
-
-rosl.init()
-node = rosl.Node(sys.argv[1])
-pub = node.create_publisher(String, sys.argv[2], 10)
-count = 0
-
-def tick():
-    global count
-    count += 1
-    pub.publish(String(data=f"hello {count}"))
-
-node.create_timer(0.01, tick)
-print("up", flush=True)
-rosl.spin(node)
-print("sent", count, flush=True)
-rosl.shutdown()
-"""
-
-LISTENER = r"""
-import sys
-import rosl
-from std_msgs.msg import String
-
-rosl.init()
-node = rosl.Node(sys.argv[1])
-good = bad = 0
-
-def on_message(msg):
-    global good, bad
-    if msg.data.startswith("hello "):
-        good += 1
-        if good % 10 == 0:
-            print("good", good, flush=True)
-    else:
-        bad += 1
-
-node.create_subscription(String, sys.argv[2], on_message, 10)
-print("up", flush=True)
-rosl.spin(node)
-print("final", good, bad, flush=True)
-rosl.shutdown()
-"""
-
-PROBE = r"""
-import sys
-import rosl
-
-rosl.init()
-node = rosl.Node("fuzz_probe")
-graph = node.participant.graph
-want = set(sys.argv[1:])
-found = graph.wait_for(lambda: want <= {n.fqn for n in graph.nodes()}, 5.0)
-print("nodes", " ".join(sorted(n.fqn for n in graph.nodes())), flush=True)
-print("found" if found else "missing", flush=True)
-rosl.shutdown()
-"""
 
 DISCOVERY_HASH = topic_hash(DISCOVERY_TOPIC)
 DISCOVERY_TYPE_HASH = type_hash(DISCOVERY_TYPE)
@@ -133,9 +72,8 @@ class Node:
         return self.out.rest(3.0), self.err.rest(3.0)
 
 
-def good_count(listener: Node) -> int:
-    counts = [int(x.split()[1]) for x in listener.out.lines if x.startswith("good ")]
-    return max(counts, default=0)
+def received(listener: Node) -> int:
+    return good_count(listener.out.lines)
 
 
 def capture_real_datagrams(domain: int, timeout: float = 10.0) -> tuple[list[bytes], list[bytes]]:
@@ -323,7 +261,7 @@ def test_nodes_survive_thousands_of_garbage_datagrams(
     listener = Node(processes, LISTENER, LISTENER_NAME)
     talker.wait_up()
     listener.wait_up()
-    assert listener.out.wait_for(lambda _: good_count(listener) >= 10, 20.0), (
+    assert listener.out.wait_for(lambda _: received(listener) >= 10, 20.0), (
         f"no messages before fuzzing: {listener.err.rest(1.0)}"
     )
     hellos, messages = capture_real_datagrams(domain_id)
@@ -336,8 +274,8 @@ def test_nodes_survive_thousands_of_garbage_datagrams(
 
     assert talker.child.poll() is None, f"talker died: {talker.err.rest(1.0)}"
     assert listener.child.poll() is None, f"listener died: {listener.err.rest(1.0)}"
-    after_fuzz = good_count(listener)
-    assert listener.out.wait_for(lambda _: good_count(listener) >= after_fuzz + 50, 20.0), (
+    after_fuzz = received(listener)
+    assert listener.out.wait_for(lambda _: received(listener) >= after_fuzz + 50, 20.0), (
         f"listener stopped receiving after the fuzzing (at {after_fuzz}): {listener.err.rest(1.0)}"
     )
 
@@ -403,7 +341,7 @@ def test_data_channel_garbage_for_a_subscribed_topic(processes: Processes, domai
     listener = Node(processes, LISTENER, LISTENER_NAME)
     talker.wait_up()
     listener.wait_up()
-    assert listener.out.wait_for(lambda _: good_count(listener) >= 10, 20.0)
+    assert listener.out.wait_for(lambda _: received(listener) >= 10, 20.0)
     rng = random.Random(5)
     topic, type_ = topic_hash(TOPIC), type_hash("std_msgs/msg/String")
     datagrams = []
@@ -418,8 +356,8 @@ def test_data_channel_garbage_for_a_subscribed_topic(processes: Processes, domai
     head = HEADER.pack(MAGIC, 1, Kind.DATA, 0, 1, 0xBAD5EED, 9999, topic, type_, 0, 1, len(cdr), 0)
     datagrams.append((channel_of(topic), head + cdr))
     blast(domain_id, datagrams)
-    after = good_count(listener)
-    assert listener.out.wait_for(lambda _: good_count(listener) >= after + 30, 20.0), (
+    after = received(listener)
+    assert listener.out.wait_for(lambda _: received(listener) >= after + 30, 20.0), (
         f"listener stopped: {listener.err.rest(1.0)}"
     )
     assert listener.child.poll() is None

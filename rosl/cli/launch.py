@@ -1,0 +1,51 @@
+"""``rosl launch PKG FILE [name:=value ...]`` or ``rosl launch PATH [name:=value ...]``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rosl.cli import render
+from rosl.launch import loader, runner
+
+
+@click.command("launch", context_settings={"ignore_unknown_options": True})
+@click.argument("target")
+@click.argument("rest", nargs=-1, type=click.UNPROCESSED)
+@click.option(
+    "-s",
+    "--show-args",
+    "--show-arguments",
+    "show_args",
+    is_flag=True,
+    help="Show arguments that may be given to the launch file",
+)
+@click.option(
+    "-p",
+    "--print",
+    "--print-description",
+    "--dry-run",
+    "print_plan",
+    is_flag=True,
+    help="Print what would start (command lines, remaps, parameters) and exit",
+)
+def command(target: str, rest: tuple[str, ...], show_args: bool, print_plan: bool) -> int:
+    """Run a launch file: `rosl launch tutorial_pkg my_launch.py` or `rosl launch ./x.launch.py`."""
+    args = list(rest)
+    if Path(target).is_file() or (
+        target.endswith((".py", ".yaml", ".yml", ".xml")) and "/" in target
+    ):
+        path = Path(target)
+    else:
+        if not args or ":=" in args[0]:
+            raise click.UsageError("give a launch file: rosl launch PKG FILE or rosl launch PATH")
+        path = loader.find_in_package(target, args.pop(0))
+    arguments = loader.parse_arguments(args)
+    if show_args:
+        render.lines(runner.show_arguments(path))
+        return 0
+    if print_plan:
+        render.lines(runner.plan(path, arguments))
+        return 0
+    return runner.launch(path, arguments)

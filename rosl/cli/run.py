@@ -1,0 +1,29 @@
+"""``rosl run PKG EXECUTABLE [args] [--ros-args ...]``: start one executable of a package."""
+
+from __future__ import annotations
+
+import os
+import shlex
+import sys
+
+import click
+
+from rosl.pkg.executables import command_line, find_executable
+
+
+@click.command(
+    "run", context_settings={"ignore_unknown_options": True, "allow_interspersed_args": False}
+)
+@click.option("--prefix", default=None, help="Prefix command, e.g. 'python -m cProfile'")
+@click.argument("package_name")
+@click.argument("executable_name")
+@click.argument("argv", nargs=-1, type=click.UNPROCESSED)
+def command(
+    prefix: str | None, package_name: str, executable_name: str, argv: tuple[str, ...]
+) -> None:
+    """Run a package specific executable (no build, no sourcing)."""
+    executable = find_executable(package_name, executable_name)
+    cmd = [*(shlex.split(prefix) if prefix else []), *command_line(executable, list(argv))]
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execvp(cmd[0], cmd)

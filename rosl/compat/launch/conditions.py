@@ -1,0 +1,7 @@
+"""launch.conditions."""
+
+from rosl.compat.unsupported import unsupported_names
+from rosl.launch.description import IfCondition, UnlessCondition
+
+__all__ = ["IfCondition", "UnlessCondition"]
+__getattr__ = unsupported_names("launch.conditions", __all__)

@@ -1,0 +1,276 @@
+"""ROSL_INTERFACE across network namespaces, and a clear error where multicast cannot work.
+
+The namespace tests need ``ip netns`` (root, or CAP_NET_ADMIN); they skip with the reason
+otherwise. Everything they send stays inside namespaces the test creates and deletes.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+from typing import TYPE_CHECKING
+
+import pytest
+
+from rosl.bus.errors import BusError
+from rosl.bus.multicast import FIX_HINT, Addressing
+from rosl.bus.transport import MulticastTransport
+from rosl.graph.announce import SELFTEST_S, Discovery
+from tests.bus.helpers import LISTENER, PROBE, TALKER, Lines, good_count, wait_exit
+from tests.conftest import wait_until
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator, Sequence
+
+    from tests.conftest import Processes
+
+TOPIC = "/netns_chatter"
+
+
+def ip(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        ["ip", *args], capture_output=True, text=True, timeout=15, check=check
+    )
+
+
+class Namespaces:
+    """Network namespaces (and their veths) made for one test; all deleted afterwards."""
+
+    def __init__(self, processes: Processes) -> None:
+        self.processes = processes
+        self.suffix = os.urandom(3).hex()
+        self.created: list[str] = []
+
+    def add(self, role: str) -> str:
+        name = f"rosl-test-{self.suffix}-{role}"
+        ip("netns", "add", name)
+        self.created.append(name)
+        return name
+
+    def run(
+        self, namespace: str, args: Sequence[str], env: dict[str, str] | None = None
+    ) -> subprocess.Popen[str]:
+        """Start a process inside a namespace (``ip netns exec`` becomes that process)."""
+        return self.processes.start(["ip", "netns", "exec", namespace, *args], env=env)
+
+    def close(self) -> None:
+        self.processes.close()  # nothing may keep a namespace alive once it is deleted
+        for name in reversed(self.created):
+            ip("netns", "del", name, check=False)
+
+
+@pytest.fixture
+def netns(processes: Processes) -> Iterator[Namespaces]:
+    if shutil.which("ip") is None:
+        pytest.skip("needs the `ip` command (iproute2)")
+    spaces = Namespaces(processes)
+    try:
+        spaces.add("probe")
+    except subprocess.CalledProcessError as err:
+        pytest.skip(f"cannot create network namespaces here: {err.stderr.strip()}")
+    try:
+        yield spaces
+    finally:
+        spaces.close()
+
+
+def veth_pair(netns: Namespaces) -> tuple[str, str, str, str]:
+    """Two namespaces joined by a veth pair with 10.77.x.1/24 and .2/24 and a multicast route.
+
+    Returns:
+        (namespace A, veth in A, namespace B, veth in B); lo stays down in both, so the
+        traffic can only use the veth.
+    """
+    a, b = netns.add("a"), netns.add("b")
+    va, vb = f"rv{netns.suffix}a", f"rv{netns.suffix}b"
+    subnet = int(netns.suffix[:2], 16) % 250 + 1
+    ip("link", "add", va, "type", "veth", "peer", "name", vb)
+    ip("link", "set", va, "netns", a)
+    ip("link", "set", vb, "netns", b)
+    for space, dev, host in ((a, va, 1), (b, vb, 2)):
+        ip("-n", space, "addr", "add", f"10.77.{subnet}.{host}/24", "dev", dev)
+        ip("-n", space, "link", "set", dev, "up")
+        ip("-n", space, "route", "add", "224.0.0.0/4", "dev", dev)
+    return a, va, b, vb
+
+
+def python(code: str, *args: str) -> list[str]:
+    return [sys.executable, "-c", code, *args]
+
+
+def stop(child: subprocess.Popen[str]) -> None:
+    if child.poll() is None:
+        child.send_signal(2)
+    if wait_exit(child, 10.0) is None:
+        child.kill()
+
+
+def test_publisher_and_subscriber_in_two_namespaces(netns: Namespaces, domain_id: int) -> None:
+    a, va, b, vb = veth_pair(netns)
+    talker = netns.run(a, python(TALKER, "netns_talker", TOPIC), env={"ROSL_INTERFACE": va})
+    listener = netns.run(b, python(LISTENER, "netns_listener", TOPIC), env={"ROSL_INTERFACE": vb})
+    talker_out, talker_err = Lines(talker.stdout), Lines(talker.stderr)
+    out, err = Lines(listener.stdout), Lines(listener.stderr)
+    try:
+        assert talker_out.wait_line("up", 20.0), f"talker: {talker_err.rest(1.0)}"
+        assert out.wait_line("up", 20.0), f"listener: {err.rest(1.0)}"
+        assert out.wait_for(lambda lines: good_count(lines) >= 20, 20.0), (
+            f"nothing crossed the veth: listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}"
+        )
+        # discovery crosses too: a fresh process next to the listener sees the talker
+        probe = netns.run(b, python(PROBE, "/netns_talker"), env={"ROSL_INTERFACE": vb})
+        probe_out, probe_err = Lines(probe.stdout), Lines(probe.stderr)
+        probe_out.wait_for(lambda lines: any(x in ("found", "missing") for x in lines), 20.0)
+        assert "found" in probe_out.lines, f"{probe_out.lines} {probe_err.rest(1.0)}"
+    finally:
+        stop(listener)
+        stop(talker)
+    assert "Traceback" not in "\n".join(err.rest(2.0) + talker_err.rest(2.0))
+
+
+def test_interface_given_by_address_works_too(netns: Namespaces, domain_id: int) -> None:
+    a, va, b, vb = veth_pair(netns)
+    subnet = int(netns.suffix[:2], 16) % 250 + 1
+    talker = netns.run(
+        a, python(TALKER, "addr_talker", TOPIC), env={"ROSL_INTERFACE": f"10.77.{subnet}.1"}
+    )
+    listener = netns.run(
+        b, python(LISTENER, "addr_listener", TOPIC), env={"ROSL_INTERFACE": f"10.77.{subnet}.2"}
+    )
+    out, err = Lines(listener.stdout), Lines(listener.stderr)
+    talker_err = Lines(talker.stderr)
+    try:
+        assert out.wait_for(lambda lines: good_count(lines) >= 20, 30.0), (
+            f"listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}"
+        )
+    finally:
+        stop(listener)
+        stop(talker)
+
+
+# --- no usable multicast: one clear line ------------------------------------------------------
+
+NODE_SPINS = r"""
+import time
+import rosl
+
+rosl.init()
+node = rosl.Node("lonely")
+end = time.monotonic() + 3
+while time.monotonic() < end:
+    rosl.spin_once(node, timeout_sec=0.1)
+rosl.shutdown()
+print("spun", flush=True)
+"""
+
+
+def assert_clear_multicast_line(line: str) -> None:
+    assert "multicast" in line
+    assert "ip link set lo up" in line
+    assert "ROSL_INTERFACE" in line
+
+
+@pytest.mark.parametrize("args", [["topic", "list"], ["node", "list"]], ids=" ".join)
+def test_cli_with_loopback_down_prints_one_line(
+    netns: Namespaces, domain_id: int, args: list[str]
+) -> None:
+    space = netns.add("lodown")  # a fresh namespace: lo exists but is down
+    child = netns.run(space, [sys.executable, "-m", "rosl", *args])
+    out, err = Lines(child.stdout), Lines(child.stderr)
+    code = wait_exit(child, 20.0)
+    lines = [x for x in err.rest(5.0) if x.strip()]
+    assert code not in (0, None), f"exit {code}; stdout {out.rest(1.0)}"
+    assert len(lines) == 1, lines
+    assert "Traceback" not in lines[0]
+    assert_clear_multicast_line(lines[0])
+
+
+def test_node_with_loopback_down_fails_with_the_multicast_hint(
+    netns: Namespaces, domain_id: int
+) -> None:
+    space = netns.add("lodown")
+    child = netns.run(space, python(NODE_SPINS))
+    out, err = Lines(child.stdout), Lines(child.stderr)
+    code = wait_exit(child, 20.0)
+    lines = [x for x in err.rest(5.0) if x.strip()]
+    assert "spun" not in out.rest(1.0), "the node ran as if multicast worked"
+    assert code not in (0, None)
+    # a user's script shows Python's traceback (only rosl's CLI turns errors into one line);
+    # what rosl owes is an error whose message is one line naming multicast and the fix
+    assert lines, "failed silently"
+    last = lines[-1]
+    assert last.startswith("rosl.bus.errors.BusError: "), lines[-5:]
+    assert_clear_multicast_line(last)
+
+
+def test_unknown_interface_in_a_namespace_names_it(netns: Namespaces, domain_id: int) -> None:
+    space = netns.add("noif")
+    child = netns.run(
+        space, [sys.executable, "-m", "rosl", "topic", "list"], env={"ROSL_INTERFACE": "nosuch7"}
+    )
+    err = Lines(child.stderr)
+    code = wait_exit(child, 20.0)
+    lines = [x for x in err.rest(5.0) if x.strip()]
+    assert code not in (0, None)
+    assert len(lines) == 1, lines
+    assert "ROSL_INTERFACE=nosuch7" in lines[0]
+
+
+# --- the loopback self-test (no namespace needed) ---------------------------------------------
+
+
+class MuteTransport:
+    """A real transport whose sends vanish: our own datagrams never come back."""
+
+    def __init__(self, inner: MulticastTransport) -> None:
+        self.inner = inner
+        self.addressing = inner.addressing
+        self.max_datagram = inner.max_datagram
+        self.pacer = inner.pacer
+
+    def send(self, channel: int, parts: object) -> None:
+        pass
+
+    def open(self, channel: int) -> object:
+        return self.inner.open(channel)
+
+    def close(self) -> None:
+        self.inner.close()
+
+
+def test_selftest_reports_one_line_when_own_datagrams_never_return(
+    domain_id: int, capsys: pytest.CaptureFixture[str]
+) -> None:
+    transport = MuteTransport(MulticastTransport(Addressing(domain_id)))
+    discovery = Discovery(transport, 0x5E1F7E57, lambda: [])  # type: ignore[arg-type]
+    try:
+        discovery.start()
+        qid = discovery.query()
+        with pytest.raises(BusError) as caught:
+            discovery.wait_complete(qid, timeout=0.2)
+        message = str(caught.value)
+        assert "\n" not in message
+        assert "multicast does not work here" in message
+        assert f"239.255.{domain_id}.0:{17400 + domain_id}" in message
+        assert FIX_HINT in message
+
+        seen: list[str] = []
+
+        def warned() -> bool:
+            seen.extend(capsys.readouterr().err.splitlines())
+            return any("multicast does not work here" in x for x in seen)
+
+        assert wait_until(warned, timeout=SELFTEST_S + 5.0)
+        time.sleep(0.5)  # it is said once, not every period
+        warned()
+        lines = [x for x in seen if x.strip()]
+        assert len(lines) == 1, lines
+        assert lines[0].startswith("rosl: error: multicast does not work here")
+        assert FIX_HINT in lines[0]
+        assert not discovery.loopback_ok.is_set()
+    finally:
+        discovery.stop()
+        transport.close()
