@@ -19,6 +19,7 @@ from rosl.errors import RoslError
 
 # name -> (module, one-line help); the module defines a click command named ``command``
 COMMANDS: dict[str, tuple[str, str]] = {
+    "bag": ("rosl.cli.bag", "Various rosbag related sub-commands"),
     "doctor": ("rosl.cli.doctor", "Check the setup: multicast, domain, packages, graph"),
     "graph": ("rosl.cli.graph", "The node/topic graph as DOT, Mermaid or text (rqt_graph)"),
     "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),

@@ -38,7 +38,7 @@ def command() -> None:
 )
 @domain_option
 def frames(wait_time: float, as_dot: bool, output: Path | None, domain_id: int | None) -> None:
-    """Listen to TF for a while and show the frame tree, who broadcasts each edge and how fast."""
+    """Show the TF frame tree (view_frames): who broadcasts each edge, how fast."""
     if output is not None:
         tf.output_format(output)  # fail before listening
     with Session(domain_id) as session:

@@ -105,11 +105,11 @@ def _event_spec(name: TypeName) -> MessageSpec:
     base = _service_base(name.name)
     service = load_spec(f"{name.package}/srv/{base}")
     assert isinstance(service, ServiceSpec)
-    text = (
-        "service_msgs/ServiceEventInfo info\n"
-        f"{base}_Request[<=1] request\n{base}_Response[<=1] response\n"
-    )
     prefix = f"{name.package}/srv/{base}"
+    text = (
+        "service_msgs/msg/ServiceEventInfo info\n"
+        f"{prefix}_Request[<=1] request\n{prefix}_Response[<=1] response\n"
+    )
     fields = (
         Field("info", FieldType("service_msgs/msg/ServiceEventInfo"), written="ServiceEventInfo"),
         Field("request", FieldType(f"{prefix}_Request", ArrayKind.BOUNDED, 1), written="x"),
@@ -308,3 +308,47 @@ def on_clear(hook: Callable[[], None]) -> None:
     """Call ``hook`` whenever :func:`clear` forgets the loaded types."""
     if hook not in _clear_hooks:
         _clear_hooks.append(hook)
+
+
+DELIMITER = "=" * 80
+
+
+def msgdef_text(type_name: str) -> str:
+    """The full ``ros2msg`` text of a type, as rosbag2 writes MCAP schemas.
+
+    The type's own text, then each message type it uses (sorted, each once, recursively)
+    after a line of 80 ``=`` and ``MSG: pkg/msg/Name``.
+
+    Raises:
+        InterfaceError: unknown type.
+    """
+    seen: set[str] = set()
+
+    def text_of(name: str) -> str:
+        spec = load_spec(name)
+        assert isinstance(spec, MessageSpec)
+        resolved = resolve(spec)
+        result = spec.text if spec.text.endswith("\n") or not spec.text else spec.text + "\n"
+        for dependency in sorted({f.type.base for f in resolved.fields if not f.type.is_primitive}):
+            if dependency not in seen:
+                seen.add(dependency)
+                result += f"\n{DELIMITER}\nMSG: {dependency}\n{text_of(dependency)}"
+        return result
+
+    key = str(parse_type_name(type_name))
+    get_message_class(key)
+    return text_of(key)
+
+
+def loaded(type_name: str) -> bool:
+    """Whether a type's class was built in this process (so its definition is at hand)."""
+    return type_name in _classes
+
+
+def schema(type_name: str) -> tuple[str, str]:
+    """(encoding, text) of the MCAP schema rosbag2 writes: ros2msg, or ros2idl for srv types."""
+    if "/srv/" in type_name:
+        from rosl.idl.idl_text import full_idl
+
+        return "ros2idl", full_idl(type_name)
+    return "ros2msg", msgdef_text(type_name)

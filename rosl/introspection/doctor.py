@@ -39,6 +39,7 @@ class CheckResult:
     summary: str
     warnings: tuple[str, ...] = ()
     details: tuple[str, ...] = ()  # why it failed, one line each
+    skipped: bool = False  # could not run because an earlier check failed (not a failure)
 
 
 @dataclass(slots=True)
@@ -46,6 +47,7 @@ class Diagnosis:
     """Every check's result plus what was learnt on the way (for ``--report``)."""
 
     checks: list[CheckResult] = field(default_factory=list)
+    domain: int | None = None
     addressing: multicast.Addressing | None = None
     domain_source: str = ""
     graph: GraphCache | None = None
@@ -72,7 +74,7 @@ def _domain(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
     del session
     ours, ros = (os.environ.get(n, "").strip() for n in ("ROSL_DOMAIN_ID", "ROS_DOMAIN_ID"))
     try:
-        result.addressing = multicast.addressing_from_env(domain)
+        result.domain = multicast.domain_from_env(domain)
     except RoslError as err:
         return CheckResult("domain", False, str(err))
     result.domain_source = (
@@ -90,17 +92,15 @@ def _domain(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
             f"ROSL_DOMAIN_ID={ours} and ROS_DOMAIN_ID={ros} disagree; rosl uses "
             f"{'--domain-id' if domain is not None else 'ROSL_DOMAIN_ID'}"
         )
-    summary = f"domain {result.addressing.domain} (from {result.domain_source})"
+    summary = f"domain {result.domain} (from {result.domain_source})"
     return CheckResult("domain", True, summary, tuple(warnings))
 
 
 def _network(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
-    del domain
-    if result.addressing is None:
+    if result.domain is None:
         return CheckResult("network", False, "not tried: no usable domain id")
-    where = result.addressing
-    route = f"{where.group(0)}:{where.port} via {where.interface} (TTL {where.ttl})"
     try:
+        where = result.addressing = multicast.addressing_from_env(domain)
         discovery = session.participant.discovery
         complete = discovery.wait_complete(discovery.query(), timeout=QUERY_TIMEOUT)
     except RoslError as err:
@@ -112,6 +112,7 @@ def _network(result: Diagnosis, session: Session, domain: int | None) -> CheckRe
         if complete
         else (f"some processes did not answer the graph query within {QUERY_TIMEOUT} s",)
     )
+    route = f"{where.group(0)}:{where.port} via {where.interface} (TTL {where.ttl})"
     summary = f"multicast works on {route}; {processes} process(es) answered"
     return CheckResult("network", True, summary, warnings)
 
@@ -163,7 +164,9 @@ def _interfaces(result: Diagnosis, session: Session, domain: int | None) -> Chec
 def _nodes(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
     del session, domain
     if result.graph is None:
-        return CheckResult("node", False, "not checked: the graph could not be queried")
+        return CheckResult(
+            "node", True, "not checked: the graph could not be queried", skipped=True
+        )
     names = Counter(n.fqn for n in result.graph.nodes())
     clashes = tuple(f"{count} nodes are named {name}" for name, count in names.items() if count > 1)
     if clashes:
@@ -175,7 +178,9 @@ def _topics(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
     del session, domain
     graph = result.graph
     if graph is None:
-        return CheckResult("topic", False, "not checked: the graph could not be queried")
+        return CheckResult(
+            "topic", True, "not checked: the graph could not be queried", skipped=True
+        )
     topics = graph.topics()
     mixed = tuple(
         f"topic {name} has more than one type: {', '.join(types)}"
@@ -209,7 +214,15 @@ def check_lines(diagnosis: Diagnosis) -> list[str]:
     """One line per check (warnings and reasons indented below), then ROS 2's summary."""
     lines = []
     for check in diagnosis.checks:
-        status = "FAIL" if not check.passed else "WARN" if check.warnings else " OK "
+        status = (
+            "FAIL"
+            if not check.passed
+            else "SKIP"
+            if check.skipped
+            else "WARN"
+            if check.warnings
+            else " OK "
+        )
         lines.append(f"[{status}] {check.name}: {check.summary}")
         lines += [f"       {line}" for line in check.details]
         lines += [f"       UserWarning: {line}" for line in check.warnings]
@@ -237,7 +250,12 @@ def report_lines(diagnosis: Diagnosis) -> list[str]:
     rosl_items = [
         ("version", rosl_version),
         ("python", sys.version.split()[0]),
-        ("domain id", f"{where.domain} ({diagnosis.domain_source})" if where else "?"),
+        (
+            "domain id",
+            f"{diagnosis.domain} ({diagnosis.domain_source})"
+            if diagnosis.domain is not None
+            else "invalid",
+        ),
         ("interface", os.environ.get("ROSL_INTERFACE", "").strip() or "loopback"),
     ]
     if diagnosis.search is not None:

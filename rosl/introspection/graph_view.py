@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from rosl.graph.records import CLIENT, PUBLISHER, SUBSCRIPTION, is_hidden
@@ -109,54 +109,42 @@ class GraphModel:
 
 
 def build(graph: GraphCache, options: GraphOptions, own_process: int | None = None) -> GraphModel:
-    """Turn the discovered graph into the picture's model, marks first, then the filters."""
+    """Turn the discovered graph into the picture's model: marks first, then the filters."""
+    shown = (lambda name: True) if options.include_hidden else (lambda name: not is_hidden(name))
     nodes: dict[str, int] = {}
-    ends: dict[tuple[str, str], dict[str, set[str]]] = {}
+    ends: dict[tuple[str, str], tuple[set[str], set[str], set[str]]] = {}
     for node in graph.nodes():
-        if node.process == own_process or not (options.include_hidden or not is_hidden(node.fqn)):
+        if node.process == own_process or not shown(node.fqn):
             continue
         nodes[node.fqn] = nodes.get(node.fqn, 0) + 1
         for endpoint in node.endpoints:
-            if is_hidden(endpoint.name) and not options.include_hidden:
-                continue
             kind = "topic" if endpoint.kind in (PUBLISHER, SUBSCRIPTION) else "service"
-            if kind == "service" and not options.services:
+            if not shown(endpoint.name) or (kind == "service" and not options.services):
                 continue
-            empty: dict[str, set[str]] = {"types": set(), "src": set(), "dst": set()}
-            slot = ends.setdefault((kind, endpoint.name), empty)
-            slot["types"].add(endpoint.type)
-            slot["src" if endpoint.kind in (PUBLISHER, CLIENT) else "dst"].add(node.fqn)
-    channels = [
-        _marked(
-            Channel(
-                name,
-                kind,
-                tuple(sorted(s["types"])),
-                tuple(sorted(s["src"])),
-                tuple(sorted(s["dst"])),
-            )
-        )
-        for (kind, name), s in sorted(ends.items(), key=lambda item: (item[0][1], item[0][0]))
-    ]
-    return _filtered(GraphModel(dict(sorted(nodes.items())), tuple(channels)), options)
+            types, sources, sinks = ends.setdefault((endpoint.name, kind), (set(), set(), set()))
+            types.add(endpoint.type)
+            (sources if endpoint.kind in (PUBLISHER, CLIENT) else sinks).add(node.fqn)
+    channels = tuple(_channel(name, kind, *sets) for (name, kind), sets in sorted(ends.items()))
+    return _filtered(GraphModel(dict(sorted(nodes.items())), channels), options)
 
 
-def _marked(channel: Channel) -> Channel:
+def _channel(name: str, kind: str, types: set[str], sources: set[str], sinks: set[str]) -> Channel:
     marks = []
-    if channel.kind == "topic":
-        if not channel.sinks:
+    if kind == "topic":
+        if not sinks:
             marks.append("dead sink")
-        if len(channel.sources) + len(channel.sinks) == 1:
+        if len(sources) + len(sinks) == 1:
             marks.append("leaf")
-    elif not channel.sinks:
+    elif not sinks:
         marks.append("no server")
-    if len(channel.types) > 1:
-        marks.append(f"{len(channel.types)} types")
-    if is_hidden(channel.name):
+    if len(types) > 1:
+        marks.append(f"{len(types)} types")
+    if is_hidden(name):
         marks.append("hidden")
     return Channel(
-        channel.name, channel.kind, channel.types, channel.sources, channel.sinks, tuple(marks)
-    )
+        name, kind, tuple(sorted(types)), tuple(sorted(sources)), tuple(sorted(sinks)),
+        tuple(marks),
+    )  # fmt: skip
 
 
 def _compile(patterns: tuple[str, ...]) -> list[re.Pattern[str]]:
@@ -188,17 +176,17 @@ def _filtered(model: GraphModel, options: GraphOptions) -> GraphModel:
     nodes = {n: k for n, k in model.nodes.items() if not dropped(n)}
     channels = [c for c in model.channels if not hidden_channel(c)]
     if include:  # keep what matches, with its direct neighbours
-        chosen = {n for n in nodes if any(p.search(n) for p in include)}
+        matched = {n for n in nodes if any(p.search(n) for p in include)}
         picked = [c for c in channels if any(p.search(c.name) for p in include)]
-        chosen |= {n for c in picked for n in (*c.sources, *c.sinks)}
-        channels = [c for c in channels if c in picked or chosen & {*c.sources, *c.sinks}]
+        chosen = matched | {n for c in picked for n in (*c.sources, *c.sinks)}
+        channels = [c for c in channels if c in picked or matched & {*c.sources, *c.sinks}]
         nodes = {n: k for n, k in nodes.items() if n in chosen}
     kept = []
     for c in channels:
         sources = tuple(n for n in c.sources if n in nodes)
         sinks = tuple(n for n in c.sinks if n in nodes)
         if sources or sinks:  # a channel whose every node was filtered out is not drawn
-            kept.append(Channel(c.name, c.kind, c.types, sources, sinks, c.marks))
+            kept.append(replace(c, sources=sources, sinks=sinks))
     return GraphModel(nodes, tuple(kept))
 
 
@@ -214,12 +202,9 @@ def _label(channel: Channel) -> list[str]:
     return [channel.name, f"[{', '.join(channel.marks)}]"] if channel.marks else [channel.name]
 
 
-def _q(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
-
-
-def _dot_label(lines: list[str]) -> str:
-    return '"' + "\\n".join(s.replace("\\", "\\\\").replace('"', '\\"') for s in lines) + '"'
+def _q(*lines: str) -> str:
+    r"""A quoted DOT string; several lines are joined with DOT's ``\n``."""
+    return '"' + "\\n".join(t.replace("\\", "\\\\").replace('"', '\\"') for t in lines) + '"'
 
 
 def _loose_ends(m: GraphModel, node: str) -> list[str]:
@@ -253,25 +238,19 @@ def to_dot(m: GraphModel, nodes_only: bool = False) -> str:
     out = ["digraph rosgraph {", "  rankdir=LR;", "  node [fontsize=10];"]
     for node in m.nodes:
         out.append(
-            f"  {_q('n:' + node)} [label={_dot_label(_node_label(m, node, nodes_only))}, "
-            "shape=ellipse];"
+            f"  {_q('n:' + node)} [label={_q(*_node_label(m, node, nodes_only))}, shape=ellipse];"
         )
     if nodes_only:
         for kind, style in (("topic", ""), ("service", ", style=dashed")):
             for (src, dst), names in _pairs(m, kind).items():
-                out.append(
-                    f"  {_q('n:' + src)} -> {_q('n:' + dst)} [label={_dot_label(names)}{style}];"
-                )
+                out.append(f"  {_q('n:' + src)} -> {_q('n:' + dst)} [label={_q(*names)}{style}];")
         return "\n".join([*out, "}"]) + "\n"
     for c in m.channels:
         ident = _q(("t:" if c.kind == "topic" else "s:") + c.name)
         shape = "box" if c.kind == "topic" else "diamond"
-        color = (
-            ', color="red"'
-            if {"dead sink", "no server"} & set(c.marks)
-            else (', color="orange"' if "leaf" in c.marks else "")
-        )
-        out.append(f"  {ident} [label={_dot_label(_label(c))}, shape={shape}{color}];")
+        loose = {"dead sink", "no server"} & set(c.marks)
+        color = ', color="red"' if loose else ', color="orange"' if "leaf" in c.marks else ""
+        out.append(f"  {ident} [label={_q(*_label(c))}, shape={shape}{color}];")
     for c in m.channels:
         ident = _q(("t:" if c.kind == "topic" else "s:") + c.name)
         style = "" if c.kind == "topic" else " [style=dashed]"

@@ -43,9 +43,8 @@ class Transform:
 
     def __mul__(self, other: Transform) -> Transform:
         """``self`` then ``other`` (parent←a times a←b gives parent←b)."""
-        moved = _rotate(self.rotation, other.translation)
-        origin = tuple(a + b for a, b in zip(self.translation, moved, strict=True))
-        return Transform(origin, _qmul(self.rotation, other.rotation))  # type: ignore[arg-type]
+        (x, y, z), (dx, dy, dz) = self.translation, _rotate(self.rotation, other.translation)
+        return Transform((x + dx, y + dy, z + dz), _qmul(self.rotation, other.rotation))
 
     def inverse(self) -> Transform:
         """The transform going the other way."""
@@ -193,14 +192,14 @@ class TfListener:
 
         self.session = session
         self.buffer = TfBuffer()
-        msg_type = rosl.get_interface("tf2_msgs/msg/TFMessage")
+        msg_type: Any = rosl.get_interface("tf2_msgs/msg/TFMessage")
         node = session.node()
         durabilities = (DurabilityPolicy.VOLATILE, DurabilityPolicy.TRANSIENT_LOCAL)
         for topic, durability in zip(TOPICS, durabilities, strict=True):
             node.create_subscription(
                 msg_type,
                 topic,
-                self._callback(topic == "/tf_static"),  # type: ignore[arg-type]
+                self._callback(topic == "/tf_static"),
                 QoSProfile(depth=100, durability=durability),
             )
         self._executor = rosl.SingleThreadedExecutor()
@@ -213,11 +212,16 @@ class TfListener:
 
         return deliver
 
-    def spin_for(self, seconds: float) -> None:
-        """Take messages for ``seconds``."""
+    def spin_for(self, seconds: float) -> bool:
+        """Take messages for ``seconds``; False as soon as Ctrl-C (or SIGTERM) asked to stop."""
+        import rosl
+
         deadline = time.monotonic() + seconds
         while (left := deadline - time.monotonic()) > 0:
+            if not rosl.ok():
+                return False
             self._executor.spin_once(timeout_sec=min(left, 0.05))
+        return rosl.ok()
 
     def name_broadcasters(self) -> None:
         """Fill each edge's broadcaster names from the graph (by publisher id)."""
@@ -245,7 +249,8 @@ def frames(session: Session, wait_time: float) -> TfBuffer:
         IntrospectionError: no transform at all arrived.
     """
     listener = TfListener(session)
-    listener.spin_for(wait_time)
+    if not listener.spin_for(wait_time):
+        raise KeyboardInterrupt
     if not listener.buffer.edges:
         raise _no_data(wait_time)
     listener.name_broadcasters()
@@ -262,8 +267,7 @@ def echo(
     """
     listener = TfListener(session)
     deadline = time.monotonic() + wait_time
-    while True:
-        listener.spin_for(0.05)
+    while listener.spin_for(0.05):
         try:
             transform, stamp = listener.buffer.lookup(source, target)
             break
@@ -273,11 +277,12 @@ def echo(
             if not listener.buffer.edges:
                 raise _no_data(wait_time) from None
             raise
+    else:
+        return
     while True:
         yield echo_text(transform, stamp)
-        if once:
+        if once or not listener.spin_for(1.0 / rate if rate > 0 else 1.0):
             return
-        listener.spin_for(1.0 / rate if rate > 0 else 1.0)
         transform, stamp = listener.buffer.lookup(source, target)
 
 

@@ -62,6 +62,7 @@ class Participant:
         self._replayers: dict[str, list[Replayer]] = {}
         self.discovery = Discovery(self.transport, self.sender, self._describe)
         self.discovery.handlers["replay"] = self._on_replay_request
+        self.discovery.handlers["typedef_request"] = self._on_typedef_request
         self.closed = False
         self.discovery.start()
 
@@ -111,6 +112,23 @@ class Participant:
             publishers = list(self._replayers.get(topic, ()))
         for publisher in publishers:
             publisher.replay(target)
+
+    def _on_typedef_request(self, message: dict[str, object]) -> None:
+        # runs on the discovery thread: someone (a recorder) needs a type this process uses
+        from rosl.idl import registry
+        from rosl.idl.errors import InterfaceError
+
+        type_name = str(message["type"])
+        if not registry.loaded(type_name):
+            return
+        try:
+            encoding, text = registry.schema(type_name)
+            digest = registry.store().type_hash(type_name)
+        except InterfaceError:
+            return
+        self.discovery.send(
+            {"op": "typedef", "type": type_name, "encoding": encoding, "text": text, "hash": digest}
+        )
 
     def listen(self, topic: int, handler: Handler) -> None:
         """Deliver messages of a topic/service hash to ``handler`` (joins its channel)."""

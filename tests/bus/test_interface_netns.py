@@ -97,6 +97,19 @@ def veth_pair(netns: Namespaces) -> tuple[str, str, str, str]:
     return a, va, b, vb
 
 
+def diagnose(*pairs: tuple[str, str]) -> str:
+    """Link counters and multicast memberships, for failure messages."""
+    report = []
+    for space, dev in pairs:
+        for args in (["-s", "link", "show", dev], ["maddr", "show", "dev", dev], ["route"]):
+            result = ip("-n", space, *args, check=False)
+            report.append(f"$ ip -n {space} {' '.join(args)}\n{result.stdout}{result.stderr}")
+        for args in (["cat", "/proc/net/snmp"], ["ss", "-uanm"]):
+            result = ip("netns", "exec", space, *args, check=False)
+            report.append(f"$ {' '.join(args)} in {space}\n{result.stdout}{result.stderr}")
+    return "\n".join(report)
+
+
 def python(code: str, *args: str) -> list[str]:
     return [sys.executable, "-c", code, *args]
 
@@ -119,6 +132,7 @@ def test_publisher_and_subscriber_in_two_namespaces(netns: Namespaces, domain_id
         assert out.wait_line("up", 20.0), f"listener: {err.rest(1.0)}"
         assert out.wait_for(lambda lines: good_count(lines) >= 20, 20.0), (
             f"nothing crossed the veth: listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}"
+            f"\n{diagnose((a, va), (b, vb))}"
         )
         # discovery crosses too: a fresh process next to the listener sees the talker
         probe = netns.run(b, python(PROBE, "/netns_talker"), env={"ROSL_INTERFACE": vb})
@@ -144,7 +158,7 @@ def test_interface_given_by_address_works_too(netns: Namespaces, domain_id: int)
     talker_err = Lines(talker.stderr)
     try:
         assert out.wait_for(lambda lines: good_count(lines) >= 20, 30.0), (
-            f"listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}"
+            f"listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}\n{diagnose((a, va), (b, vb))}"
         )
     finally:
         stop(listener)

@@ -1,0 +1,488 @@
+"""Recording the bus to a rosbag2 folder of MCAP files.
+
+Every datagram the recorder hears is written as it arrived: the payload bytes exactly as
+sent (no re-serialisation), ``log_time`` = receive time, ``publish_time`` = send time, one
+sequence counter per channel. Topic names and types come from discovery, so topics that
+appear later are picked up; a type this process cannot read from .msg files is asked of the
+publisher's process. Service requests and responses become ``<service>/_service_event``
+messages as ROS 2's service introspection writes them. Chunks go to disk (flushed and
+fsynced) at least once a second, so a killed recorder loses at most the last second;
+``rosl bag reindex`` repairs such a folder.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, BinaryIO
+
+from rosl.bag import metadata
+from rosl.bag.errors import BagError
+from rosl.bus.header import Kind, topic_hash, type_hash
+from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION, is_hidden
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from rosl.bus.wire import Delivery
+    from rosl.node.participant import Participant
+
+FLUSH_EVERY_S = 1.0
+PENDING_LIMIT_S = 3.0
+PENDING_MAX = 20000
+
+
+@dataclass(slots=True)
+class _Topic:
+    info: metadata.TopicInfo
+    encoding: str
+    text: str
+    endpoint: int
+    sequence: int = 0
+
+
+@dataclass(slots=True)
+class _File:
+    path: Path
+    handle: BinaryIO
+    writer: Any
+    info: metadata.FileInfo
+    opened: float = field(default_factory=time.monotonic)
+    schemas: dict[str, int] = field(default_factory=dict)
+    channels: dict[str, int] = field(default_factory=dict)
+
+
+class Recorder:
+    """Records a domain's traffic until stopped."""
+
+    def __init__(
+        self,
+        folder: Path,
+        *,
+        topics: list[str] | None = None,
+        exclude: str | None = None,
+        services: bool = False,
+        include_hidden: bool = False,
+        max_bag_size: int = 0,
+        max_bag_duration: float = 0.0,
+        compression: str | None = None,
+        domain: int | str | None = None,
+        log: Callable[[str], None] | None = None,
+    ) -> None:
+        self.folder = folder
+        self.topics = set(topics) if topics else None
+        self.exclude = re.compile(exclude) if exclude else None
+        self.services = services
+        self.include_hidden = include_hidden
+        self.max_bag_size = max_bag_size
+        self.max_bag_duration = max_bag_duration
+        self.compression = compression
+        self.domain = domain
+        self._log = log or (lambda line: print(line, file=sys.stderr, flush=True))
+        self.participant: Participant | None = None
+        self._file: _File | None = None
+        self._files: list[metadata.FileInfo] = []
+        self._topics: dict[str, _Topic] = {}
+        self._names: dict[tuple[int, int], tuple[str, str, str]] = {}  # (topic hash, type hash)
+        self._generation = -1
+        self._synced = -1
+        self._node_index = 0
+        self._pending: list[Delivery] = []
+        self._pending_since: dict[tuple[int, int], float] = {}
+        self._typedefs: dict[str, tuple[str, str, str]] = {}
+        self._asked: dict[str, float] = {}
+        self._lock = threading.Lock()
+        self._last_flush = time.monotonic()
+        self.dropped_unknown = 0
+        self.skipped_types: set[str] = set()
+        self.stopped = False
+
+    # --- lifecycle ---------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Create the folder, join the bus, and start listening.
+
+        Raises:
+            BagError: the folder exists already or cannot be created.
+        """
+        from rosl.node.participant import Participant
+
+        if self.folder.exists() and any(self.folder.iterdir()):
+            raise BagError(f"Output folder '{self.folder}' already exists and is not empty")
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            probe = self.folder / ".rosl-write-test"
+            probe.write_bytes(b"")
+            probe.unlink()
+        except OSError as err:
+            raise BagError(f"cannot record into '{self.folder}': {err.strerror}") from None
+        self.participant = Participant(self.domain)
+        self.participant.discovery.handlers["typedef"] = self._on_typedef
+        self._node_index = self.participant.add_node(self._describe)
+        if self.topics is None or self.services:
+            self.participant.listen_all()
+        else:
+            for name in self.topics:
+                self.participant.listen(topic_hash(name), _Ignore())
+        discovery = self.participant.discovery
+        discovery.wait_complete(discovery.query(), timeout=1.0)
+        self._open_file()
+        self._log("[INFO] [rosl_recorder]: Listening for topics...")
+        self._sync_graph()
+        self._log(f"[INFO] [rosl_recorder]: Recording to '{self.folder}'...")
+
+    def step(self, timeout: float = 0.1) -> None:
+        """Receive and write what arrives within ``timeout``; flush once a second."""
+        assert self.participant is not None
+        self.participant.poll(timeout, sink=self._on_delivery)
+        self._sync_graph()
+        now = time.monotonic()
+        if self._pending:
+            self._retry_pending(now)
+        if now - self._last_flush >= FLUSH_EVERY_S:
+            self._flush()
+            self._last_flush = now
+            self._maybe_split(now)
+
+    def run(self, until: Callable[[], bool]) -> None:
+        """Record until ``until()`` is true."""
+        while not until():
+            self.step(0.1)
+
+    def close(self) -> None:
+        """Finish the MCAP file(s) with their index and write metadata.yaml (idempotent)."""
+        if self.stopped:
+            return
+        self.stopped = True
+        if self.participant is not None and not self.participant.closed:
+            self.participant.poll(0.0, sink=self._on_delivery)
+        if self._pending:
+            self._retry_pending(time.monotonic() + PENDING_LIMIT_S + 1)
+        self._close_file()
+        if self.participant is not None:
+            self.participant.close()
+        infos = [t.info for t in self._topics.values()]
+        metadata.write(self.folder, infos, self._files)
+        total = sum(t.count for t in infos)
+        lost = self.participant.reader.lost() if self.participant is not None else 0
+        self._log(
+            f"[INFO] [rosl_recorder]: Recording stopped: {total} messages on "
+            f"{sum(1 for t in infos if t.count)} topics, {lost} lost in transit"
+            + (
+                f", {self.dropped_unknown} of unknown topics dropped"
+                if self.dropped_unknown
+                else ""
+            )
+        )
+
+    # --- files -------------------------------------------------------------------------------
+
+    def _open_file(self) -> None:
+        from mcap.writer import CompressionType, Writer
+
+        index = len(self._files)
+        path = self.folder / f"{self.folder.name}_{index}.mcap"
+        compression = {
+            None: CompressionType.NONE, "none": CompressionType.NONE,
+            "zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
+        }[self.compression]  # fmt: skip
+        try:
+            handle = path.open("wb")
+        except OSError as err:
+            raise BagError(f"cannot create {path}: {err.strerror}") from None
+        writer = Writer(handle, compression=compression, chunk_size=4 * 1024 * 1024)
+        writer.start(profile="ros2", library="rosl")
+        info = metadata.FileInfo(path.name)
+        self._files.append(info)
+        self._file = _File(path, handle, writer, info)
+
+    def _close_file(self) -> None:
+        current = self._file
+        if current is None:
+            return
+        self._file = None
+        try:
+            current.writer.finish()
+            current.handle.flush()
+            os.fsync(current.handle.fileno())
+            current.handle.close()
+        except OSError as err:
+            raise BagError(f"cannot finish {current.path}: {err.strerror}") from None
+
+    def _flush(self) -> None:
+        current = self._file
+        if current is None:
+            return
+        try:
+            current.writer.flush()
+            os.fsync(current.handle.fileno())
+        except OSError as err:
+            raise BagError(f"cannot write {current.path}: {err.strerror} (disk full?)") from None
+
+    def _maybe_split(self, now: float) -> None:
+        current = self._file
+        if current is None or not current.info.count:
+            return
+        too_big = self.max_bag_size and current.handle.tell() >= self.max_bag_size
+        too_long = self.max_bag_duration and now - current.opened >= self.max_bag_duration
+        if too_big or too_long:
+            self._close_file()
+            self._open_file()
+
+    # --- messages ----------------------------------------------------------------------------
+
+    def _on_delivery(self, delivery: Delivery) -> None:
+        if delivery.kind == Kind.DATA:
+            self._record_data(delivery)
+        elif self.services and delivery.kind in (Kind.REQUEST, Kind.RESPONSE):
+            self._record_service(delivery)
+
+    def _resolve(self, delivery: Delivery, kinds: tuple[str, ...]) -> tuple[str, str, str] | None:
+        assert self.participant is not None
+        graph = self.participant.graph
+        if graph.generation != self._generation:
+            self._generation = graph.generation
+            self._names = {}
+            for node, endpoint in graph.endpoints():
+                key = (topic_hash(endpoint.name), type_hash(endpoint.type))
+                qos = endpoint.qos if endpoint.kind == PUBLISHER else {}
+                if key not in self._names or qos:
+                    self._names[key] = (endpoint.name, endpoint.type, endpoint.kind)
+                del node
+        found = self._names.get((delivery.topic, delivery.type))
+        if found is None or found[2] not in kinds:
+            return None
+        return found
+
+    def _wanted(self, name: str) -> bool:
+        if self.topics is not None and name not in self.topics:
+            return False
+        if self.exclude is not None and self.exclude.search(name):
+            return False
+        return self.include_hidden or not is_hidden(name)
+
+    def _record_data(self, delivery: Delivery) -> None:
+        found = self._resolve(delivery, (PUBLISHER, SUBSCRIPTION))
+        if found is None:
+            self._hold(delivery)
+            return
+        name, type_name, _ = found
+        if not self._wanted(name):
+            return
+        topic = self._subscribe(name, type_name)
+        if topic is None:
+            self._hold(delivery)
+            return
+        self._write(name, topic, delivery, bytes(delivery.payload))
+
+    def _record_service(self, delivery: Delivery) -> None:
+        from rosl.idl.errors import InterfaceError
+        from rosl.node.service_events import event_from_delivery, event_topic, event_type_name
+
+        found = self._resolve(delivery, (SERVER, CLIENT))
+        if found is None:
+            self._hold(delivery)
+            return
+        service, service_type, _ = found
+        name = event_topic(service)
+        if self.exclude is not None and self.exclude.search(name):
+            return
+        try:
+            event = event_from_delivery(delivery, service_type)
+        except InterfaceError:
+            if service_type not in self.skipped_types:
+                self.skipped_types.add(service_type)
+                self._log(f"[WARN] [rosl_recorder]: service type {service_type} is unknown here; "
+                          f"events of {service} are not recorded")  # fmt: skip
+            return
+        if event is None:
+            return
+        from rosl.idl import registry
+
+        topic = self._subscribe(name, event_type_name(service_type), qos={"depth": 10})
+        if topic is not None:
+            self._write(name, topic, delivery, registry.store().serialize(event))
+
+    def _write(self, name: str, topic: _Topic, delivery: Delivery, data: bytes) -> None:
+        current = self._file
+        assert current is not None
+        channel_id = current.channels.get(name)
+        if channel_id is None:
+            channel_id = self._register(current, name, topic)
+        topic.sequence += 1
+        current.writer.add_message(
+            channel_id=channel_id, log_time=delivery.received, data=data,
+            publish_time=delivery.stamp, sequence=topic.sequence,
+        )  # fmt: skip
+        topic.info.count += 1
+        info = current.info
+        info.count += 1
+        info.start_ns = (
+            delivery.received if info.count == 1 else min(info.start_ns, delivery.received)
+        )
+        info.end_ns = max(info.end_ns, delivery.received)
+
+    def _register(self, current: _File, name: str, topic: _Topic) -> int:
+        import yaml
+
+        type_name = topic.info.type
+        schema_id = current.schemas.get(type_name)
+        if schema_id is None:
+            schema_id = (
+                current.writer.register_schema(type_name, topic.encoding, topic.text.encode())
+                if topic.text
+                else 0
+            )
+            current.schemas[type_name] = schema_id
+        qos_text = yaml.safe_dump(topic.info.qos, sort_keys=False) if topic.info.qos else ""
+        channel_id: int = current.writer.register_channel(
+            name, "cdr", schema_id, {"offered_qos_profiles": qos_text}
+        )
+        current.channels[name] = channel_id
+        return channel_id
+
+    def _subscribe(
+        self, name: str, type_name: str, qos: dict[str, Any] | None = None
+    ) -> _Topic | None:
+        """Start recording a topic (its schema known); None while its type is being asked for."""
+        existing = self._topics.get(name)
+        if existing is not None:
+            return existing
+        found = self._schema(type_name)
+        if found is None:
+            return None
+        encoding, text, digest = found
+        assert self.participant is not None
+        info = metadata.TopicInfo(name, type_name, qos=self._qos(name, qos), type_hash=digest)
+        topic = _Topic(info, encoding, text, self.participant.next_endpoint())
+        self._topics[name] = topic
+        self._log(f"[INFO] [rosl_recorder]: Subscribed to topic '{name}'")
+        self.participant.discovery.changed()
+        return topic
+
+    def _sync_graph(self) -> None:
+        """Subscribe to every wanted topic (and service) as soon as the graph shows it."""
+        from rosl.node.service_events import event_topic, event_type_name
+
+        assert self.participant is not None
+        graph = self.participant.graph
+        if graph.generation == self._synced:
+            return
+        self._synced = graph.generation
+        for _, endpoint in graph.endpoints(PUBLISHER):
+            if endpoint.name not in self._topics and self._wanted(endpoint.name):
+                self._subscribe(endpoint.name, endpoint.type)
+        if self.services:
+            for _, endpoint in graph.endpoints(SERVER):
+                name = event_topic(endpoint.name)
+                if name not in self._topics and not (self.exclude and self.exclude.search(name)):
+                    try:
+                        self._subscribe(name, event_type_name(endpoint.type), qos={"depth": 10})
+                    except Exception:
+                        continue
+
+    def _describe(self) -> Any:
+        """The recorder as a node in the graph, subscribed to what it records."""
+        from rosl.graph.records import EndpointRecord, NodeRecord
+
+        assert self.participant is not None
+        endpoints = tuple(
+            EndpointRecord(
+                SUBSCRIPTION,
+                name,
+                t.info.type,
+                t.endpoint,
+                {
+                    "reliability": "RELIABLE",
+                    "durability": "VOLATILE",
+                    "history": "KEEP_LAST",
+                    "depth": 1000,
+                },
+                {"received": t.info.count},
+            )
+            for name, t in list(self._topics.items())
+        )
+        return NodeRecord(
+            "rosbag2_recorder", "/", self.participant.sender, self._node_index, endpoints
+        )
+
+    def _qos(self, name: str, given: dict[str, Any] | None) -> list[dict[str, Any]]:
+        assert self.participant is not None
+        if given is not None:
+            return [metadata.qos_entry(given)]
+        return [
+            metadata.qos_entry(e.qos) for _, e in self.participant.graph.endpoints(PUBLISHER, name)
+        ]
+
+    def _schema(self, type_name: str) -> tuple[str, str, str] | None:
+        from rosl.idl import registry
+        from rosl.idl.errors import InterfaceError
+
+        with self._lock:
+            if type_name in self._typedefs:
+                return self._typedefs[type_name]
+        try:
+            encoding, text = registry.schema(type_name)
+            found = (encoding, text, registry.store().type_hash(type_name))
+        except InterfaceError:
+            return self._ask(type_name)
+        with self._lock:
+            self._typedefs[type_name] = found
+        return found
+
+    def _ask(self, type_name: str) -> tuple[str, str, str] | None:
+        """Ask the publisher's process for a type this process cannot read."""
+        assert self.participant is not None
+        now = time.monotonic()
+        asked = self._asked.setdefault(type_name, now)
+        if now - asked > PENDING_LIMIT_S:
+            self._log(f"[WARN] [rosl_recorder]: nobody described type {type_name}; recording "
+                      "its messages without a schema")  # fmt: skip
+            found = ("", "", "")
+            with self._lock:
+                self._typedefs[type_name] = found
+            return found
+        if asked == now:
+            self.participant.discovery.send({"op": "typedef_request", "type": type_name})
+        return None
+
+    def _on_typedef(self, message: dict[str, Any]) -> None:  # discovery thread
+        with self._lock:
+            self._typedefs.setdefault(
+                str(message["type"]),
+                (str(message["encoding"]), str(message["text"]), str(message.get("hash", ""))),
+            )
+
+    def _hold(self, delivery: Delivery) -> None:
+        key = (delivery.topic, delivery.type)
+        self._pending_since.setdefault(key, time.monotonic())
+        if len(self._pending) < PENDING_MAX:
+            self._pending.append(delivery)
+        else:
+            self.dropped_unknown += 1
+
+    def _retry_pending(self, now: float) -> None:
+        waiting, self._pending = self._pending, []
+        for delivery in waiting:
+            self._on_delivery(delivery)
+        still = {(d.topic, d.type) for d in self._pending}
+        for key in list(self._pending_since):
+            if key not in still:
+                del self._pending_since[key]
+            elif now - self._pending_since[key] > PENDING_LIMIT_S:
+                before = len(self._pending)
+                self._pending = [d for d in self._pending if (d.topic, d.type) != key]
+                self.dropped_unknown += before - len(self._pending)
+                del self._pending_since[key]
+
+
+class _Ignore:
+    """A handler for topics the recorder listens to through its sink."""
+
+    def deliver(self, delivery: Delivery) -> None:
+        """Unused: the recorder reads through ``poll(sink=...)``."""
