@@ -30,7 +30,18 @@ from rosl.launch import loader, runner
     is_flag=True,
     help="Print what would start (command lines, remaps, parameters) and exit",
 )
-def command(target: str, rest: tuple[str, ...], show_args: bool, print_plan: bool) -> int:
+@click.option(
+    "--record",
+    "record",
+    is_flag=False,
+    flag_value="",
+    default=None,
+    metavar="[DIR]",
+    help="Record everything on the bus while the launch runs (rosbag2 folder)",
+)
+def command(
+    target: str, rest: tuple[str, ...], show_args: bool, print_plan: bool, record: str | None
+) -> int:
     """Run a launch file: `rosl launch tutorial_pkg my_launch.py` or `rosl launch ./x.launch.py`."""
     args = list(rest)
     if Path(target).is_file() or (
@@ -48,4 +59,9 @@ def command(target: str, rest: tuple[str, ...], show_args: bool, print_plan: boo
     if print_plan:
         render.lines(runner.plan(path, arguments))
         return 0
-    return runner.launch(path, arguments)
+    folder = None
+    if record is not None:
+        import datetime
+
+        folder = Path(record or datetime.datetime.now().strftime("launch_%Y_%m_%d-%H_%M_%S"))
+    return runner.launch(path, arguments, record=folder)

@@ -61,11 +61,27 @@ def plan(path: Path, arguments: dict[str, str]) -> list[str]:
     return lines
 
 
-def launch(path: Path, arguments: dict[str, str], *, supervisor: Supervisor | None = None) -> int:
-    """Run a launch file until every process has ended (or Ctrl-C); return the exit status."""
+def launch(
+    path: Path,
+    arguments: dict[str, str],
+    *,
+    supervisor: Supervisor | None = None,
+    record: Path | None = None,
+) -> int:
+    """Run a launch file until every process has ended (or Ctrl-C); return the exit status.
+
+    Args:
+        path: the launch file.
+        arguments: ``name:=value`` launch arguments.
+        supervisor: the supervisor to use (a fresh one by default).
+        record: record everything on the bus, from before the first node starts until the
+            last one exits, into this folder.
+    """
     chosen = supervisor or Supervisor()
     chosen.log("INFO", "launch", f"All log files can be found below {chosen.log_dir}")
     chosen.log("INFO", "launch", "Default logging verbosity is set to INFO")
+    if record is not None:
+        start_recorder(chosen, record)
     context = LaunchContext(chosen, arguments)
     context.files.append(path)
     os.environ.setdefault("PYTHONUNBUFFERED", "1")
@@ -76,3 +92,25 @@ def launch(path: Path, arguments: dict[str, str], *, supervisor: Supervisor | No
         chosen.run()
         raise
     return chosen.run()
+
+
+def start_recorder(supervisor: Supervisor, folder: Path) -> None:
+    """Start ``rosl bag record -a --include-services`` and wait (bounded) until it listens.
+
+    Raises:
+        LaunchError: the recorder could not start (e.g. the folder exists).
+    """
+    import sys
+
+    from rosl.launch.errors import LaunchError
+    from rosl.launch.supervisor import ProcessSpec
+
+    cmd = [sys.executable, "-m", "rosl", "bag", "record", "-a", "--include-services",
+           "-o", str(folder)]  # fmt: skip
+    spec = ProcessSpec(name="rosbag2_recorder", cmd=cmd, env=dict(os.environ), output="screen",
+                       background=True, sigterm_timeout=10.0, sigkill_timeout=5.0)  # fmt: skip
+    label = supervisor.start(spec, None, None)
+    if not supervisor.wait_for_line(label, "Recording to", timeout=10.0):
+        supervisor.shutdown("the recorder did not start")
+        supervisor.run()
+        raise LaunchError("the recorder did not start (its output is above); nothing was launched")

@@ -58,6 +58,7 @@ class ProcessSpec:
     sigterm_timeout: float = 5.0
     sigkill_timeout: float = 5.0
     details: dict[str, Any] = field(default_factory=dict)
+    background: bool = False  # e.g. the recorder: stopped after every other process ended
 
 
 @dataclass(slots=True)
@@ -79,7 +80,7 @@ class Running:
     spec: ProcessSpec
     label: str
     action: Any
-    context: LaunchContext
+    context: LaunchContext | None
     popen: subprocess.Popen[bytes]
     partial: dict[int, bytes] = field(default_factory=dict)
     signals: list[tuple[float, int]] = field(default_factory=list)  # (sent at, signal)
@@ -117,6 +118,8 @@ class Supervisor:
         self._shutdown_reason: str | None = None
         self._log_file: IO[str] | None = None
         self._interrupts = 0
+        self._watch: tuple[str, str] | None = None
+        self._seen = False
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -161,13 +164,17 @@ class Supervisor:
     # --- starting ----------------------------------------------------------------------------
 
     def start(
-        self, spec: ProcessSpec, action: Any, context: LaunchContext, label: str | None = None
-    ) -> None:
-        """Start a process (or, in a dry run, just record it)."""
+        self,
+        spec: ProcessSpec,
+        action: Any,
+        context: LaunchContext | None,
+        label: str | None = None,
+    ) -> str:
+        """Start a process (or, in a dry run, just record it); return its ``name-N`` label."""
         self.planned.append(spec)
-        if self.dry_run or self._shutdown_reason is not None:
-            return
         label = label or f"{spec.name}-{next(self._counter)}"
+        if self.dry_run or self._shutdown_reason is not None:
+            return label
         env = {**spec.env, "PYTHONUNBUFFERED": "1"}
         if spec.emulate_tty and self.color:
             env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
@@ -180,7 +187,7 @@ class Supervisor:
         except OSError as err:
             self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
             self.failed.append(label)
-            return
+            return label
         self.started += 1
         running = Running(spec, label, action, context, popen)
         self._running.append(running)
@@ -189,7 +196,21 @@ class Supervisor:
             os.set_blocking(pipe.fileno(), False)
             self._selector.register(pipe, selectors.EVENT_READ, running)
         self.log("INFO", label, f"process started with pid [{popen.pid}]")
-        self._emit(ProcessEvent("start", action, label, popen.pid, None, spec.cmd), context)
+        if context is not None:
+            self._emit(ProcessEvent("start", action, label, popen.pid, None, spec.cmd), context)
+        return label
+
+    def wait_for_line(self, label: str, text: str, timeout: float) -> bool:
+        """Supervise until process ``label`` prints a line containing ``text`` (bounded)."""
+        deadline = time.monotonic() + timeout
+        self._watch = (label, text)
+        self._seen = False
+        while not self._seen and time.monotonic() < deadline:
+            if not any(r.label == label for r in self._running):
+                break
+            self._step()
+        self._watch = None
+        return self._seen
 
     def call_later(self, seconds: float, function: Callable[[], None]) -> None:
         """Run ``function`` after ``seconds`` (TimerAction)."""
@@ -216,7 +237,8 @@ class Supervisor:
         self._timers.clear()
         self._respawns.clear()
         for running in self._running:
-            self._signal(running, signal.SIGINT)
+            if not running.spec.background:  # helpers (the recorder) stop after the rest
+                self._signal(running, signal.SIGINT)
 
     def _signal(self, running: Running, signum: int) -> None:
         running.stopping = True
@@ -249,6 +271,14 @@ class Supervisor:
             while self._running or (
                 self._shutdown_reason is None and (self._timers or self._respawns)
             ):
+                foreground = [r for r in self._running if not r.spec.background]
+                pending = self._timers or self._respawns
+                if self._shutdown_reason is None and not foreground and not pending:
+                    self.shutdown("all processes have finished")
+                if self._shutdown_reason is not None and not foreground:
+                    for helper in self._running:  # the last one left: stop the helpers now
+                        if not helper.stopping:
+                            self._signal(helper, signal.SIGINT)
                 self._step()
         finally:
             for sig, handler in previous.items():
@@ -318,6 +348,8 @@ class Supervisor:
 
     def _route(self, running: Running, raw: bytes, stderr: bool) -> None:
         text = raw.decode("utf-8", "replace").rstrip("\r")
+        if self._watch is not None and running.label == self._watch[0] and self._watch[1] in text:
+            self._seen = True
         output = running.spec.output
         to_screen = output in ("screen", "both") or (output == "log" and stderr)
         to_log = output in ("log", "both")
@@ -354,10 +386,9 @@ class Supervisor:
             )
             if not running.stopping:
                 self.failed.append(running.label)
-        self._emit(
-            ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd),
-            running.context,
-        )
+        if running.context is not None:
+            event = ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd)
+            self._emit(event, running.context)
         if running.spec.respawn and self._shutdown_reason is None:
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip

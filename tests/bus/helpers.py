@@ -191,10 +191,15 @@ def on_message(msg):
     else:
         bad += 1
 
-node.create_subscription(String, sys.argv[2], on_message, 10)
+sub = node.create_subscription(String, sys.argv[2], on_message, 10)
 print("up", flush=True)
 rosl.spin(node)
+reader = node.participant.reader
 print("final", good, bad, flush=True)
+print("stats", f"received={sub.received} mismatched={sub.mismatched}",
+      f"undecodable={sub.undecodable} bus={reader.received()} lost={reader.lost()}",
+      f"foreign={reader.foreign} unwanted={reader.unwanted}",
+      f"malformed={reader.reassembler.malformed}", flush=True)
 rosl.shutdown()
 """
 

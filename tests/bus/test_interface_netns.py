@@ -130,10 +130,14 @@ def test_publisher_and_subscriber_in_two_namespaces(netns: Namespaces, domain_id
     try:
         assert talker_out.wait_line("up", 20.0), f"talker: {talker_err.rest(1.0)}"
         assert out.wait_line("up", 20.0), f"listener: {err.rest(1.0)}"
-        assert out.wait_for(lambda lines: good_count(lines) >= 20, 20.0), (
-            f"nothing crossed the veth: listener {err.lines[-5:]}, talker {talker_err.lines[-5:]}"
-            f"\n{diagnose((a, va), (b, vb))}"
-        )
+        if not out.wait_for(lambda lines: good_count(lines) >= 20, 20.0):
+            network = diagnose((a, va), (b, vb))
+            stop(listener)
+            stop(talker)
+            pytest.fail(
+                f"nothing crossed the veth: listener {out.rest(2.0)[-3:]} {err.rest(2.0)[-5:]}, "
+                f"talker {talker_out.rest(2.0)[-3:]} {talker_err.rest(2.0)[-5:]}\n{network}"
+            )
         # discovery crosses too: a fresh process next to the listener sees the talker
         probe = netns.run(b, python(PROBE, "/netns_talker"), env={"ROSL_INTERFACE": vb})
         probe_out, probe_err = Lines(probe.stdout), Lines(probe.stderr)

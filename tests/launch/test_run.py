@@ -1,0 +1,133 @@
+"""``rosl run PKG EXECUTABLE``: find the executable through package.xml, run it, pass its exit on."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pytest
+
+from tests.launch.support import one_error_line
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
+    from tests.launch.support import Rosl
+
+MANIFEST = """<?xml version="1.0"?>
+<package format="3">
+  <name>tools_pkg</name>
+  <version>0.0.0</version>
+  <export>
+    <rosl>
+      <executable name="exit_three">tools_pkg.exits:sys_exit_three</executable>
+      <executable name="return_three">tools_pkg.exits:return_three</executable>
+      <executable name="show_env">tools_pkg.exits:show_env</executable>
+      <executable name="tool">scripts/tool.py</executable>
+    </rosl>
+  </export>
+</package>
+"""
+
+EXITS = """
+import os
+import sys
+
+
+def sys_exit_three():
+    print("exiting with 3", flush=True)
+    sys.exit(3)
+
+
+def return_three():
+    return 3
+
+
+def show_env():
+    print("FOO=" + os.environ.get("FOO", "<unset>"), flush=True)
+"""
+
+TOOL = """
+import sys
+
+print("tool ran with", sys.argv[1:], flush=True)
+"""
+
+
+@pytest.fixture
+def tools_pkg(make_package: Callable[..., Path]) -> Path:
+    """A workspace package with module executables and one declared as a file path."""
+    return make_package(
+        "tools_pkg",
+        {
+            "tools_pkg/__init__.py": "",
+            "tools_pkg/exits.py": EXITS,
+            "scripts/tool.py": TOOL,
+        },
+        manifest=MANIFEST,
+    )
+
+
+def test_run_starts_the_tutorial_timer_node_with_a_parameter_from_ros_args(rosl: Rosl) -> None:
+    node = rosl.start(
+        "run", "tutorial_pkg", "timer_node", "--ros-args", "-p", "timer_period_s:=0.2"
+    )
+
+    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.2 s$", "err"), node.both()
+    assert node.wait_for(r"\[timer_node\]: Tick 1 \(period 0\.2 s\)$", "err"), node.both()
+    assert node.interrupt() == 0, node.both()
+    assert "Traceback" not in node.text("err")
+
+
+@pytest.mark.parametrize("executable", ["exit_three", "return_three"])
+def test_run_exits_with_the_exit_code_of_the_executable(
+    rosl: Rosl, tools_pkg: Path, executable: str
+) -> None:
+    code, _, err = rosl.run("run", "tools_pkg", executable)
+
+    assert code == 3, err
+    assert "Traceback" not in err
+
+
+def test_run_prefix_wraps_the_command_like_ros2_run(rosl: Rosl, tools_pkg: Path) -> None:
+    code, out, err = rosl.run("run", "--prefix", "env FOO=1", "tools_pkg", "show_env")
+
+    assert code == 0, err
+    assert out.splitlines() == ["FOO=1"]
+
+
+def test_run_without_prefix_leaves_the_environment_alone(rosl: Rosl, tools_pkg: Path) -> None:
+    code, out, err = rosl.run("run", "tools_pkg", "show_env")
+
+    assert code == 0, err
+    assert out.splitlines() == ["FOO=<unset>"]
+
+
+def test_run_starts_an_executable_declared_as_a_file_path(rosl: Rosl, tools_pkg: Path) -> None:
+    code, out, err = rosl.run("run", "tools_pkg", "tool", "a", "--b")
+
+    assert code == 0, err
+    assert out.splitlines() == ["tool ran with ['a', '--b']"]
+
+
+def test_run_of_an_unknown_executable_lists_the_package_executables_closest_first(
+    rosl: Rosl,
+) -> None:
+    code, out, err = rosl.run("run", "tutorial_pkg", "timer_nod")
+
+    assert code == 1
+    assert out == ""
+    line = one_error_line(err)
+    assert line == (
+        "no executable 'timer_nod' in package 'tutorial_pkg'; it has: "
+        "timer_node, count_images, my_publisher, my_subscriber"
+    )
+
+
+def test_run_of_an_unknown_package_names_it_and_suggests_the_closest(rosl: Rosl) -> None:
+    code, out, err = rosl.run("run", "tutorial_pk", "timer_node")
+
+    assert code == 1
+    assert out == ""
+    line = one_error_line(err)
+    assert line.startswith("package 'tutorial_pk' not found (did you mean 'tutorial_pkg'?)"), line
