@@ -7,7 +7,7 @@ import shlex
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rosl.launch.description import Action, LaunchDescription, process
+from rosl.launch.description import Action, LaunchDescription, check_required_arguments, process
 from rosl.launch.errors import LaunchError
 from rosl.launch.substitutions import SomeSubstitutions, perform, resolve_value
 
@@ -162,6 +162,7 @@ class IncludeLaunchDescription(Action):
         for name, value in self.launch_arguments:
             context.launch_configurations[perform(context, name)] = perform(context, value)
         description = load_description(path)
+        check_required_arguments(description, context, path)
         context.files.append(path)
         try:
             process(description.entities, context)
@@ -170,14 +171,16 @@ class IncludeLaunchDescription(Action):
 
     def children(self) -> list[Any]:
         """The included file's entities, when the path needs no launch configuration."""
+        from rosl.launch.context import LaunchContext
         from rosl.launch.loader import load_description
 
         location = getattr(self.launch_description_source, "location", None)
-        if isinstance(location, (str, Path)) and Path(location).is_file():
-            try:
-                return load_description(Path(location)).entities
-            except LaunchError:
-                return []
+        try:  # as launch does: the path expanded with an empty context
+            path = Path(perform(LaunchContext(None, {}), location))
+            if path.is_file():
+                return load_description(path).entities
+        except Exception:
+            return []
         return []
 
 

@@ -9,6 +9,7 @@ from rosl.launch.substitutions import SomeSubstitutions, perform
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
+    from pathlib import Path
 
     from rosl.launch.context import LaunchContext
 
@@ -115,6 +116,45 @@ class LaunchDescription:
         for entity in self.entities:
             walk(entity, False)
         return found
+
+
+def check_required_arguments(
+    description: LaunchDescription, context: LaunchContext, path: Path
+) -> None:
+    """Refuse a description before anything starts if a required argument was not given.
+
+    As launch's IncludeLaunchDescription does: an argument with no default, declared
+    unconditionally anywhere in the description, must be among the given configurations.
+    """
+    from rosl.launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+
+    required: list[Any] = []
+
+    def walk(entity: Any, conditional: bool, given: frozenset[str]) -> None:
+        if isinstance(entity, DeclareLaunchArgument):
+            if not conditional and entity.default_value is None and entity.name not in given:
+                required.append(entity)
+            return
+        nested = conditional or getattr(entity, "condition", None) is not None
+        if isinstance(entity, IncludeLaunchDescription):  # the include may supply them
+            names = set()
+            for name, _ in entity.launch_arguments:
+                try:
+                    names.add(perform(context, name))
+                except Exception:
+                    continue
+            given = given | names
+        for child in entity.children() if hasattr(entity, "children") else []:
+            walk(child, nested, given)
+
+    for entity in description.entities:
+        walk(entity, False, frozenset())
+    for argument in required:
+        if argument.name not in context.launch_configurations:
+            raise LaunchError(
+                f"{path}: launch argument '{argument.name}' is required "
+                f"({argument.description}); pass it as {argument.name}:=<value>"
+            )
 
 
 def process(entities: Iterable[Any], context: LaunchContext) -> None:

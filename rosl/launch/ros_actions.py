@@ -1,4 +1,4 @@
-"""launch_ros's actions: Node, PushRosNamespace, SetParameter, SetRemap.
+"""launch_ros's actions: Node, PushRosNamespace, SetParameter, SetRemap (and ParameterValue).
 
 A Node becomes ``<executable> [arguments] --ros-args -r __node:=NAME -r __ns:=NS
 --params-file FILE -r from:=to ...`` — the same ``--ros-args`` a user could type. Parameter
@@ -17,6 +17,75 @@ from rosl.launch.substitutions import SomeSubstitutions, Substitution, perform, 
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
+
+
+class ParameterValue:
+    """A parameter value given explicitly, optionally with its type (launch_ros's class).
+
+    Without ``value_type`` a substituted value is read by YAML rules, as any other; with it
+    (``str``, ``int``, ``float``, ``bool`` or a list of one of them) it is converted to it.
+    """
+
+    def __init__(self, value: Any, *, value_type: Any = None) -> None:
+        self.value = value
+        self.value_type = value_type
+
+
+def _yaml_typed(text: str) -> Any:
+    """``'0.9'`` -> 0.9, ``'true'`` -> True, ``'[1, 2]'`` -> [1, 2]; other text stays text."""
+    import yaml
+
+    try:
+        loaded = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+    if isinstance(loaded, (bool, int, float, str)):
+        return loaded
+    if (
+        isinstance(loaded, list)
+        and loaded
+        and len({type(v) for v in loaded}) == 1
+        and isinstance(loaded[0], (bool, int, float, str))
+    ):
+        return loaded
+    return text
+
+
+def _substituted(value: Any) -> bool:
+    if isinstance(value, Substitution):
+        return True
+    return (
+        isinstance(value, (list, tuple))
+        and bool(value)
+        and all(isinstance(v, (str, Substitution)) for v in value)
+        and any(isinstance(v, Substitution) for v in value)
+    )
+
+
+def parameter_value(context: LaunchContext, value: Any) -> Any:
+    """A parameter's value as launch_ros evaluates it: substitutions by YAML rules."""
+    if isinstance(value, ParameterValue):
+        resolved = parameter_value(context, value.value)
+        kind = value.value_type
+        if kind is None:
+            return resolved
+        try:
+            if kind is str:
+                return perform(context, value.value) if _substituted(value.value) else str(resolved)
+            if kind is bool and isinstance(resolved, str):
+                return _yaml_typed(resolved) is True
+            return kind(resolved)
+        except (TypeError, ValueError):
+            raise LaunchError(
+                f"parameter value {resolved!r} is not a {getattr(kind, '__name__', kind)}"
+            ) from None
+    if _substituted(value):
+        return _yaml_typed(perform(context, value))
+    if isinstance(value, dict):
+        return {perform(context, k): parameter_value(context, v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [parameter_value(context, v) for v in value]
+    return resolve_value(context, value)
 
 
 class Node(ExecuteProcess):
@@ -58,12 +127,12 @@ class Node(ExecuteProcess):
     def _parameter_arguments(self, context: LaunchContext) -> tuple[list[str], dict[str, Any]]:
         values: dict[str, Any] = {}
         for name, value in context.scope.parameters:
-            values[perform(context, name)] = resolve_value(context, value)
+            values[perform(context, name)] = parameter_value(context, value)
         files: list[str] = []
         for entry in self.parameters:
             if isinstance(entry, dict):
                 for key, value in entry.items():
-                    values[perform(context, key)] = resolve_value(context, value)
+                    values[perform(context, key)] = parameter_value(context, value)
             elif isinstance(entry, (str, Path, Substitution, list, tuple)):
                 path = Path(perform(context, entry) if not isinstance(entry, Path) else entry)
                 if not path.is_file():
@@ -146,11 +215,11 @@ class Node(ExecuteProcess):
     ) -> tuple[list[str], dict[str, Any]]:
         values: dict[str, Any] = {}
         for name, value in context.scope.parameters:
-            values[perform(context, name)] = resolve_value(context, value)
+            values[perform(context, name)] = parameter_value(context, value)
         for entry in self.parameters:
             if isinstance(entry, dict):
                 values.update(
-                    {perform(context, k): resolve_value(context, v) for k, v in entry.items()}
+                    {perform(context, k): parameter_value(context, v) for k, v in entry.items()}
                 )
             else:
                 values[

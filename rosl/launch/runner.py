@@ -7,7 +7,7 @@ import shlex
 from typing import TYPE_CHECKING
 
 from rosl.launch.context import LaunchContext
-from rosl.launch.description import process
+from rosl.launch.description import check_required_arguments, process
 from rosl.launch.loader import load_description
 from rosl.launch.substitutions import describe
 from rosl.launch.supervisor import Supervisor
@@ -41,7 +41,9 @@ def plan(path: Path, arguments: dict[str, str]) -> list[str]:
     supervisor = Supervisor(dry_run=True)
     context = LaunchContext(supervisor, arguments)
     context.files.append(path)
-    process(load_description(path).entities, context)
+    description = load_description(path)
+    check_required_arguments(description, context, path)
+    process(description.entities, context)
     lines = []
     for index, spec in enumerate(supervisor.planned, start=1):
         lines.append(f"[{spec.name}-{index}] {shlex.join(spec.cmd)}")
@@ -86,7 +88,9 @@ def launch(
     context.files.append(path)
     os.environ.setdefault("PYTHONUNBUFFERED", "1")
     try:
-        process(load_description(path).entities, context)
+        description = load_description(path)
+        check_required_arguments(description, context, path)
+        process(description.entities, context)
     except BaseException:
         chosen.shutdown("launch file failed")
         chosen.run()

@@ -71,7 +71,7 @@ class LaunchConfiguration(Substitution):
 
     def describe(self) -> str:
         """``LaunchConfig('name')``."""
-        return f"LaunchConfig('{describe(self.variable_name)}')"
+        return f"LaunchConfig({describe(self.variable_name)})"
 
 
 class EnvironmentVariable(Substitution):
@@ -93,7 +93,7 @@ class EnvironmentVariable(Substitution):
 
     def describe(self) -> str:
         """``EnvVar('NAME')``."""
-        return f"EnvVar('{describe(self.name)}')"
+        return f"EnvVar({describe(self.name)})"
 
 
 class PathJoinSubstitution(Substitution):
@@ -128,8 +128,8 @@ class FindPackageShare(Substitution):
             raise LaunchError(str(err)) from None
 
     def describe(self) -> str:
-        """``FindPackageShare('pkg')``."""
-        return f"FindPackageShare('{describe(self.package)}')"
+        """``Pkg(pkg='name')``, as launch_ros describes it."""
+        return f"Pkg(pkg={describe(self.package)})"
 
 
 FindPackagePrefix = FindPackageShare

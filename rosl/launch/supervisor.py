@@ -156,8 +156,10 @@ class Supervisor:
         import yaml
 
         folder = self.log_dir / "params"
-        folder.mkdir(parents=True, exist_ok=True)
         path = folder / f"{label.replace('/', '_')}-{next(self._param_files)}.yaml"
+        if self.dry_run:  # --print writes nothing
+            return path
+        folder.mkdir(parents=True, exist_ok=True)
         path.write_text(yaml.safe_dump({"/**": {"ros__parameters": values}}), encoding="utf-8")
         return path
 
@@ -317,9 +319,16 @@ class Supervisor:
         if last == signal.SIGKILL or now - sent_at < timeout:
             return
         following = signal.SIGTERM if last == signal.SIGINT else signal.SIGKILL
+        # ROS 2 prints the time since SIGINT: the SIGKILL step shows both timeouts added up
+        # (as a float, '10.0': launch computes it with a PythonExpression)
+        shown = (
+            f"{timeout:g}"
+            if last == signal.SIGINT
+            else str(float(running.spec.sigterm_timeout + timeout))
+        )
         self.log(
             "ERROR", running.label,
-            f"process[{running.label}] failed to terminate '{timeout}' seconds after receiving "
+            f"process[{running.label}] failed to terminate '{shown}' seconds after receiving "
             f"'{signal.Signals(last).name}', escalating to '{signal.Signals(following).name}'",
         )  # fmt: skip
         self._signal(running, following)

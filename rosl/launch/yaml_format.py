@@ -193,9 +193,10 @@ class _Reader:
             if "from" in param:
                 params.append(self.text(param["from"]))
             else:
-                values[str(self.need(param, "name", line))] = _plain(
-                    self.need(param, "value", line)
-                )
+                value = _plain(self.need(param, "value", line))
+                if isinstance(value, str) and "$(" in value:
+                    value = self.text(value)  # typed by YAML rules once substituted
+                values[str(self.need(param, "name", line))] = value
         if values:
             params.insert(0, values)
         remaps = [

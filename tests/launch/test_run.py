@@ -89,14 +89,20 @@ def test_run_exits_with_the_exit_code_of_the_executable(
     assert "Traceback" not in err
 
 
-def test_run_prefix_wraps_the_command_like_ros2_run(rosl: Rosl, tools_pkg: Path) -> None:
+def test_run_prefix_wraps_the_command_like_ros2_run(
+    rosl: Rosl, tools_pkg: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("FOO", raising=False)
     code, out, err = rosl.run("run", "--prefix", "env FOO=1", "tools_pkg", "show_env")
 
     assert code == 0, err
     assert out.splitlines() == ["FOO=1"]
 
 
-def test_run_without_prefix_leaves_the_environment_alone(rosl: Rosl, tools_pkg: Path) -> None:
+def test_run_without_prefix_leaves_the_environment_alone(
+    rosl: Rosl, tools_pkg: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("FOO", raising=False)
     code, out, err = rosl.run("run", "tools_pkg", "show_env")
 
     assert code == 0, err
