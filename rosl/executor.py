@@ -128,17 +128,34 @@ class Executor:
             self.spin_once(timeout_sec=None)
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
-        """Wait up to ``timeout_sec`` (None: until something happens) and run ready callbacks."""
-        self._run_timers()
+        """Wait up to ``timeout_sec`` (None: until something happens) and run ready callbacks.
+
+        Afterwards, answer a lock-stepped simulator whose messages were handled (see
+        :mod:`rosl.node.lockstep`): the answer follows the timers the new ``/clock`` made due.
+        """
+        ran = self._run_timers()
         participant = self.context.participant
         wait = self._wait_time(timeout_sec)
         if participant is None:
             if wait is None:
                 wait = 0.1
             time.sleep(wait)
-        else:
-            participant.poll(wait)
-        self._run_timers()
+            self._run_timers()
+            return
+        answerer = participant.answerer or participant.answer_lockstep()
+        participant.poll(wait)
+        ran += self._run_timers()
+        if answerer.seen:
+            answerer.answer(self._next_sim_wakeup(), ran > 0)
+
+    def _next_sim_wakeup(self) -> int:
+        """The earliest sim-time timer deadline (ns), -1 when no sim-time timer is armed."""
+        soonest = -1
+        for timer in self._timers():
+            if timer.clock.ros_time_is_active and not timer.is_canceled():
+                due = timer.clock.now_ns() + (timer.time_until_next_call() or 0)
+                soonest = due if soonest < 0 else min(soonest, due)
+        return soonest
 
     def spin_until_future_complete(self, future: Future, timeout_sec: float | None = None) -> None:
         """Spin until ``future`` is done, the timeout passes, or the context shuts down."""
@@ -174,11 +191,14 @@ class Executor:
             return 0.0
         return wait
 
-    def _run_timers(self) -> None:
+    def _run_timers(self) -> int:
+        ran = 0
         for node in list(self._nodes):
             for timer in list(node.timers):
                 if timer.is_ready() and not timer.destroyed:
+                    ran += 1
                     node.run_callback(timer.call, "timer")
+        return ran
 
 
 class SingleThreadedExecutor(Executor):

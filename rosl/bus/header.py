@@ -56,6 +56,7 @@ class Flags(enum.IntFlag):
 
     NONE = 0
     ADDRESSED = 1  # the payload starts with an ADDRESS record
+    LOCKSTEP = 2  # sent by a lock-stepped simulator: subscribers answer when they handled it
 
 
 class Header(NamedTuple):

@@ -44,6 +44,7 @@ class Delivery(NamedTuple):
     received: int  # receive time (ns), taken when the last datagram was read
     payload: memoryview | bytearray | mmap.mmap
     address: tuple[int, int, int] | None = None  # (process, endpoint, correlation)
+    flags: int = 0  # header flags (Flags.LOCKSTEP matters to subscribers)
 
 
 @dataclass(slots=True)
@@ -80,6 +81,8 @@ class Writer:
         self.chunk = transport.max_datagram - HEADER_SIZE
         self._seq = itertools.count(1)
         self.sent = 0
+        self.last_seq = 0  # the sequence number of the last message sent
+        self.flags = 0  # extra header flags for every message (Flags.LOCKSTEP)
 
     def send(
         self,
@@ -100,7 +103,7 @@ class Writer:
             stamp: the send time to record (ns); now by default.
         """
         number = (next(self._seq) if seq is None else seq) & 0xFFFFFFFF
-        flags = 0
+        flags = self.flags
         if address is not None:
             payload = ADDRESS.pack(*address) + bytes(payload)
             flags = Flags.ADDRESSED
@@ -126,6 +129,8 @@ class Writer:
                 pace.spend(len(view))
                 self.transport.send(self.channel, [head, view])
         self.sent += 1
+        if seq is None:
+            self.last_seq = number
         return number
 
 
@@ -202,7 +207,9 @@ class Reader:
             if kind == Kind.DATA:
                 self._count(sender, endpoint, topic, seq, now)
             out.append(
-                Delivery(kind, sender, endpoint, seq, topic, type_, stamp, now, payload, address)
+                Delivery(
+                    kind, sender, endpoint, seq, topic, type_, stamp, now, payload, address, flags
+                )
             )
         return True
 

@@ -69,6 +69,7 @@ class Discovery:
         self.handlers: dict[str, Callable[[dict[str, Any]], None]] = {}
         self.loopback_ok = threading.Event()
         self.malformed = 0
+        self.lockstep = False  # announced: this process answers lock-stepped simulators
         self._describe = describe
         self._transport = transport
         self._writer = Writer(
@@ -197,7 +198,9 @@ class Discovery:
                 self._send({"op": "bye", "sender": f"{self.sender:016x}"})
             return
         self._has_announced = True
-        record = ProcessRecord(self.sender, os.getpid(), HOST, nodes, next(self._version))
+        record = ProcessRecord(
+            self.sender, os.getpid(), HOST, nodes, next(self._version), lockstep=self.lockstep
+        )
         known = [f"{s:016x}" for s in self.cache.senders()]
         self._send(
             {"op": "hello", "process": to_json(record), "known": known, "reply_to": reply_to}

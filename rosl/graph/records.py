@@ -64,6 +64,7 @@ class ProcessRecord:
     nodes: tuple[NodeRecord, ...]
     version: int
     seen: float = 0.0  # time.monotonic() of the last announcement
+    lockstep: bool = False  # spins an executor that answers a lock-stepped simulator
 
 
 def gid(process: int, endpoint: int) -> str:
@@ -84,6 +85,7 @@ def to_json(record: ProcessRecord) -> dict[str, Any]:
         "pid": record.pid,
         "host": record.host,
         "version": record.version,
+        "lockstep": record.lockstep,
         "nodes": [
             {
                 "name": n.name,
@@ -115,5 +117,6 @@ def from_json(data: dict[str, Any], seen: float) -> ProcessRecord:
         for n in data["nodes"]
     )
     return ProcessRecord(
-        sender, int(data["pid"]), str(data["host"]), nodes, int(data["version"]), seen
-    )
+        sender, int(data["pid"]), str(data["host"]), nodes, int(data["version"]), seen,
+        bool(data.get("lockstep", False)),
+    )  # fmt: skip

@@ -255,6 +255,8 @@ class Node:
     def destroy_publisher(self, publisher: Publisher) -> bool:
         """Remove a publisher."""
         self.participant.remove_replayer(publisher.topic, publisher)
+        if publisher._writer in self.participant.writers:
+            self.participant.writers.remove(publisher._writer)
         return self._remove(self.publishers, publisher)
 
     def destroy_subscription(self, subscription: Subscription) -> bool:

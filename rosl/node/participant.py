@@ -15,9 +15,10 @@ import select
 import threading
 from typing import TYPE_CHECKING, Protocol
 
+from rosl.bus.header import Flags
 from rosl.bus.multicast import addressing_from_env
 from rosl.bus.transport import MulticastTransport, channel_of
-from rosl.bus.wire import Delivery, Reader
+from rosl.bus.wire import Delivery, Reader, Writer
 from rosl.graph.announce import Discovery
 
 if TYPE_CHECKING:
@@ -26,6 +27,7 @@ if TYPE_CHECKING:
 
     from rosl.graph.cache import GraphCache
     from rosl.graph.records import NodeRecord
+    from rosl.node.lockstep import Answerer
 
 
 class Handler(Protocol):
@@ -60,6 +62,8 @@ class Participant:
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
         self._replayers: dict[str, list[Replayer]] = {}
+        self.writers: list[Writer] = []  # the publishers' writers (lock-step answers list them)
+        self.answerer: Answerer | None = None  # created when an executor first spins
         self.discovery = Discovery(self.transport, self.sender, self._describe)
         self.discovery.handlers["replay"] = self._on_replay_request
         self.discovery.handlers["typedef_request"] = self._on_typedef_request
@@ -196,10 +200,14 @@ class Participant:
             except OSError:
                 pass
         deliveries = pending
+        drained = 0
         for sock in ready:
             if sock is not self._wake_read:
+                drained += 1
                 while self.reader.drain(sock, deliveries):
                     pass
+        if drained > 1 or pending:
+            deliveries.sort(key=_send_order)  # in the order they were sent, across channels
         for delivery in deliveries:
             if sink is not None:
                 sink(delivery)
@@ -209,8 +217,21 @@ class Participant:
 
     def dispatch(self, delivery: Delivery) -> None:
         """Hand one delivery to the handlers of its topic/service hash."""
-        for handler in self._handlers.get(delivery.topic, ()):
+        handlers = self._handlers.get(delivery.topic, ())
+        for handler in handlers:
             handler.deliver(delivery)
+        if delivery.flags & Flags.LOCKSTEP and handlers and self.answerer is not None:
+            self.answerer.handled(delivery)
+
+    def answer_lockstep(self) -> Answerer:
+        """Start answering lock-stepped simulators (announced in this process's record)."""
+        if self.answerer is None:
+            from rosl.node.lockstep import Answerer
+
+            self.answerer = Answerer(self)
+            self.discovery.lockstep = True
+            self.discovery.changed()
+        return self.answerer
 
     def defer(self, deliveries: list[Delivery]) -> None:
         """Queue deliveries read by a nested wait for the next :meth:`poll`."""
@@ -248,3 +269,7 @@ class Participant:
         for fd in (self._wake_read, self._wake_write):
             with contextlib.suppress(OSError):
                 os.close(fd)
+
+
+def _send_order(delivery: Delivery) -> int:
+    return delivery.stamp

@@ -30,6 +30,7 @@ class Publisher:
         self._writer = Writer(
             participant.transport, participant.sender, self.endpoint, topic, self.type_name
         )
+        participant.writers.append(self._writer)
         self._store = registry.store()
         self._history: collections.deque[tuple[int, int, bytes]] | None = (
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
