@@ -101,6 +101,8 @@ class Recorder:
         self.dropped_unknown = 0
         self.skipped_types: set[str] = set()
         self.stopped = False
+        self.sim_time = False  # set by record_at: log times come from a simulator's clock
+        self._chunk_ns = 0
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -149,6 +151,39 @@ class Recorder:
             self._last_flush = now
             self._maybe_split(now)
 
+    def record_at(
+        self, now_ns: int, caught_up: Callable[[], bool] | None = None, timeout: float = 1.0
+    ) -> None:
+        """Write what has arrived as of sim time ``now_ns`` (a simulator's in-process recorder).
+
+        Every message gets ``now_ns`` as log and publish time and the messages of one call are
+        written in an order that does not depend on arrival order, so the same simulation gives
+        the same bag. ``caught_up`` says when everything expected has arrived (bounded by
+        ``timeout``). Chunks close every second of sim time; the file is fsynced at most once
+        a second of wall time.
+        """
+        assert self.participant is not None
+        self.sim_time = True
+        arrived: list[Delivery] = []
+        deadline = time.monotonic() + timeout
+        self.participant.poll(0.0, sink=arrived.append)
+        while caught_up is not None and not caught_up() and time.monotonic() < deadline:
+            self.participant.poll(0.002, sink=arrived.append)
+        self._sync_graph()
+        arrived.sort(key=_arrival_free_order)
+        for delivery in arrived:
+            self._on_delivery(delivery._replace(received=now_ns, stamp=now_ns))
+        if self._pending:
+            self._retry_pending(time.monotonic())
+        if now_ns - self._chunk_ns >= 1_000_000_000:
+            self._chunk_ns = now_ns
+            wall = time.monotonic()
+            if self._file is not None:
+                self._file.writer.flush()
+                if wall - self._last_flush >= FLUSH_EVERY_S:
+                    self._flush()
+                    self._last_flush = wall
+
     def run(self, until: Callable[[], bool]) -> None:
         """Record until ``until()`` is true."""
         while not until():
@@ -159,7 +194,7 @@ class Recorder:
         if self.stopped:
             return
         self.stopped = True
-        if self.participant is not None and not self.participant.closed:
+        if self.participant is not None and not self.participant.closed and not self.sim_time:
             self.participant.poll(0.0, sink=self._on_delivery)
         if self._pending:
             self._retry_pending(time.monotonic() + PENDING_LIMIT_S + 1)
@@ -167,6 +202,8 @@ class Recorder:
         if self.participant is not None:
             self.participant.close()
         infos = [t.info for t in self._topics.values()]
+        if self.sim_time:  # the same run gives the same metadata
+            infos.sort(key=lambda info: info.name)
         metadata.write(self.folder, infos, self._files)
         total = sum(t.count for t in infos)
         lost = self.participant.reader.lost() if self.participant is not None else 0
@@ -415,9 +452,10 @@ class Recorder:
         assert self.participant is not None
         if given is not None:
             return [metadata.qos_entry(given)]
-        return [
+        entries = [
             metadata.qos_entry(e.qos) for _, e in self.participant.graph.endpoints(PUBLISHER, name)
         ]
+        return sorted(entries, key=repr)
 
     def _schema(self, type_name: str) -> tuple[str, str, str] | None:
         from rosl.idl import registry
@@ -479,6 +517,11 @@ class Recorder:
                 self._pending = [d for d in self._pending if (d.topic, d.type) != key]
                 self.dropped_unknown += before - len(self._pending)
                 del self._pending_since[key]
+
+
+def _arrival_free_order(delivery: Delivery) -> tuple[int, int, int, bytes]:
+    """Topic, sequence, endpoint, bytes: the same for the same messages, however they came."""
+    return (delivery.topic, delivery.seq, delivery.endpoint, bytes(delivery.payload))
 
 
 class _Ignore:

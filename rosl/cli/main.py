@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "pkg": ("rosl.cli.pkg", "Various package related sub-commands"),
     "run": ("rosl.cli.run", "Run a package specific executable"),
     "service": ("rosl.cli.service", "Various service related sub-commands"),
+    "sim": ("rosl.cli.sim", "Simulate a 2D world: TurtleBot3 or Dolly, LiDAR, odometry, /clock"),
     "tf": ("rosl.cli.tf", "TF frames: the tree (view_frames) and transforms (tf2_echo)"),
     "topic": ("rosl.cli.topic", "Various topic related sub-commands"),
 }

@@ -91,7 +91,7 @@ def search_roots(cwd: Path | None = None) -> list[tuple[Path, str, int]]:
     for entry in os.environ.get("ROSL_PACKAGE_PATH", "").split(os.pathsep):
         if entry.strip():
             roots.append((Path(entry).expanduser().resolve(), "ROSL_PACKAGE_PATH", _MAX_DEPTH))
-    for name in ("interfaces", "examples"):
+    for name in ("interfaces", "worlds", "examples"):
         try:
             roots.append((shipped_dir(name), "shipped", 2))
         except FileNotFoundError:

@@ -398,6 +398,13 @@ class Supervisor:
         if running.context is not None:
             event = ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd)
             self._emit(event, running.context)
+            on_exit = getattr(running.action, "on_exit", None)
+            if on_exit is not None:  # ExecuteProcess(on_exit=...): a handler for itself
+                from rosl.launch.actions import OnProcessExit
+                from rosl.launch.description import process
+
+                own = OnProcessExit(target_action=running.action, on_exit=on_exit)
+                process(own.entities(event, running.context), running.context)
         if running.spec.respawn and self._shutdown_reason is None:
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip

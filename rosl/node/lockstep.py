@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.bus.header import Flags, topic_hash
 from rosl.bus.wire import Writer
 from rosl.graph.records import SUBSCRIPTION
+from rosl.node.errors import NodeError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -40,7 +41,7 @@ CLOCK_HASH = topic_hash("/clock")
 _TOPIC_HASH = topic_hash(TOPIC)
 
 
-class LockstepStall(Exception):  # noqa: N818 - reads as what happened
+class LockstepStall(NodeError):  # noqa: N818 - reads as what happened
     """A lock-step peer did not answer in time and the simulator was told to stop."""
 
 
@@ -150,6 +151,9 @@ class LockstepSource:
         self._generation = -1
         self.waits = 0  # steps that waited for at least one peer
         self.stalls = 0
+        from rosl.idl import registry
+
+        registry.get_message_class(TYPE)  # the store decodes only types it has loaded
         participant.listen(_TOPIC_HASH, self)
 
     def mark(self, publisher: Publisher) -> None:

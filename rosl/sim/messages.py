@@ -1,0 +1,284 @@
+"""The simulator's messages: Clock, Odometry, TF, JointState, LaserScan, markers, URDF.
+
+Plain builders from simulation state to ROS 2 messages (Gazebo's conventions: odometry
+covariances of its diff-drive plugin, ``odom -> base_footprint`` on ``/tf``, fixed frames once on
+``/tf_static``, scans with +inf for no return). The world's geometry goes out as a
+``visualization_msgs/MarkerArray`` in the ``world`` frame, which ``/tf_static`` ties to each
+robot's odometry frame at its spawn pose.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+from typing import TYPE_CHECKING, Any
+from xml.sax.saxutils import quoteattr
+
+from rosl.idl.registry import get_message_class
+from rosl.sim import lidar as lidar_cast
+from rosl.sim.worldfile import Circle, Polygon, Segment
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from rosl.sim.simulation import SimRobot
+    from rosl.sim.worldfile import Lidar, RobotModel, RobotSpec, World
+
+NS = 1_000_000_000
+WORLD_FRAME = "world"
+# Gazebo's diff-drive plugin: small variance on x, y, yaw; "unknown" (1e12) on z, roll, pitch
+POSE_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+
+
+@cache
+def msg(type_name: str) -> Any:
+    """A message class (cached)."""
+    return get_message_class(type_name)
+
+
+def stamp(now_ns: int) -> Any:
+    """A builtin_interfaces/Time."""
+    sec, nanosec = divmod(now_ns, NS)
+    return msg("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec)
+
+
+def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of roll-pitch-yaw angles."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
+
+
+def clock(now_ns: int) -> Any:
+    """rosgraph_msgs/Clock."""
+    return msg("rosgraph_msgs/msg/Clock")(clock=stamp(now_ns))
+
+
+def odometry(sim_robot: SimRobot, now_ns: int) -> Any:
+    """nav_msgs/Odometry of a robot, in its odom frame."""
+    model = sim_robot.robot.spec.model
+    (x, y, yaw), (forward, turn) = sim_robot.robot.odometry()
+    message = msg("nav_msgs/msg/Odometry")()
+    message.header.stamp = stamp(now_ns)
+    message.header.frame_id = model.odom_frame
+    message.child_frame_id = model.base_frame
+    pose = message.pose.pose
+    pose.position.x, pose.position.y = x, y
+    pose.orientation.z, pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    message.twist.twist.linear.x = forward
+    message.twist.twist.angular.z = turn
+    covariance = [0.0] * 36
+    for k, value in enumerate(POSE_COVARIANCE):
+        covariance[k * 7] = value
+    message.pose.covariance = covariance
+    message.twist.covariance = covariance
+    return message
+
+
+def multiply(
+    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
+) -> tuple[float, float, float, float]:
+    """The quaternion product a * b (rotate by b, then by a)."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def transform(
+    parent: str,
+    child: str,
+    now_ns: int,
+    xyz: tuple[float, float, float],
+    rpy: tuple[float, float, float],
+    spin: float = 0.0,
+) -> Any:
+    """A geometry_msgs/TransformStamped (``spin``: a joint angle about the child's z axis)."""
+    message = msg("geometry_msgs/msg/TransformStamped")()
+    message.header.stamp = stamp(now_ns)
+    message.header.frame_id = parent
+    message.child_frame_id = child
+    t = message.transform.translation
+    t.x, t.y, t.z = xyz
+    r = message.transform.rotation
+    rotation = quaternion(*rpy)
+    if spin:
+        rotation = multiply(rotation, (0.0, 0.0, math.sin(spin / 2), math.cos(spin / 2)))
+    r.x, r.y, r.z, r.w = rotation
+    return message
+
+
+def odom_tf(sim_robot: SimRobot, now_ns: int) -> Any:
+    """tf2_msgs/TFMessage with ``odom -> base_footprint``."""
+    model = sim_robot.robot.spec.model
+    (x, y, yaw), _ = sim_robot.robot.odometry()
+    return msg("tf2_msgs/msg/TFMessage")(
+        transforms=[
+            transform(model.odom_frame, model.base_frame, now_ns, (x, y, 0.0), (0.0, 0.0, yaw))
+        ]
+    )
+
+
+def static_tf(world: World, now_ns: int) -> Any:
+    """tf2_msgs/TFMessage with every fixed frame: world -> odom (spawn pose), and the robots'."""
+    transforms = []
+    for spec in world.robots:
+        model = spec.model
+        x, y, yaw = spec.pose
+        transforms.append(
+            transform(WORLD_FRAME, model.odom_frame, now_ns, (x, y, 0.0), (0.0, 0.0, yaw))
+        )
+        transforms += [
+            transform(frame.parent, frame.name, now_ns, frame.xyz, frame.rpy)
+            for frame in model.frames
+            if frame.joint is None
+        ]
+    return msg("tf2_msgs/msg/TFMessage")(transforms=transforms)
+
+
+def wheel_tf(sim_robot: SimRobot, now_ns: int) -> Any | None:
+    """tf2_msgs/TFMessage with the wheel links turned by their joints (robot_state_publisher)."""
+    model = sim_robot.robot.spec.model
+    moving = [f for f in model.frames if f.joint is not None]
+    if not moving:
+        return None
+    angles = dict(zip(model.joints, sim_robot.robot.wheels, strict=False))
+    return msg("tf2_msgs/msg/TFMessage")(
+        transforms=[
+            transform(
+                frame.parent,
+                frame.name,
+                now_ns,
+                frame.xyz,
+                frame.rpy,
+                angles.get(frame.joint or "", 0.0),
+            )
+            for frame in moving
+        ]
+    )
+
+
+def joint_states(sim_robot: SimRobot, now_ns: int) -> Any:
+    """sensor_msgs/JointState of the wheels (angle and speed)."""
+    import numpy as np
+
+    robot = sim_robot.robot
+    model = robot.spec.model
+    message = msg("sensor_msgs/msg/JointState")()
+    message.header.stamp = stamp(now_ns)
+    message.name = list(model.joints)
+    message.position = np.array(robot.wheels[: len(model.joints)], dtype=np.float64)
+    message.velocity = np.array(robot.wheel_rates[: len(model.joints)], dtype=np.float64)
+    message.effort = np.zeros(0, dtype=np.float64)
+    return message
+
+
+def laser_scan(lidar: Lidar, ranges: np.ndarray, now_ns: int) -> Any:
+    """sensor_msgs/LaserScan with Gazebo's conventions."""
+    import numpy as np
+
+    message = msg("sensor_msgs/msg/LaserScan")()
+    message.header.stamp = stamp(now_ns)
+    message.header.frame_id = lidar.frame_id
+    message.angle_min = lidar.angle_min
+    message.angle_max = lidar.angle_max
+    message.angle_increment = lidar_cast.increment(lidar)
+    message.time_increment = 0.0
+    message.scan_time = 1.0 / lidar.rate
+    message.range_min = lidar.range_min
+    message.range_max = lidar.range_max
+    message.ranges = ranges
+    message.intensities = np.zeros(0, dtype=np.float32)
+    return message
+
+
+def world_markers(world: World, now_ns: int) -> Any:
+    """visualization_msgs/MarkerArray of the static geometry (and where movable bodies start)."""
+    marker_type = msg("visualization_msgs/msg/Marker")
+    point = msg("geometry_msgs/msg/Point")
+    markers = []
+    lines = marker_type()
+    lines.header.stamp = stamp(now_ns)
+    lines.header.frame_id = WORLD_FRAME
+    lines.ns, lines.id, lines.type, lines.action = "walls", 0, marker_type.LINE_LIST, 0
+    lines.pose.orientation.w = 1.0
+    lines.scale.x = 0.02
+    lines.color.r = lines.color.g = lines.color.b = 0.3
+    lines.color.a = 1.0
+    shapes = list(world.statics) + [body.shape for body in world.dynamics]
+    for shape in shapes:
+        if isinstance(shape, Polygon):
+            pts = list(shape.points)
+            for a, b in zip(pts, pts[1:] + pts[:1], strict=True):
+                lines.points += [point(x=a[0], y=a[1]), point(x=b[0], y=b[1])]
+        elif isinstance(shape, Segment):
+            lines.points += [point(x=shape.a[0], y=shape.a[1]), point(x=shape.b[0], y=shape.b[1])]
+    markers.append(lines)
+    for number, shape in enumerate((s for s in shapes if isinstance(s, Circle)), start=1):
+        cylinder = marker_type()
+        cylinder.header = lines.header
+        cylinder.ns, cylinder.id, cylinder.type, cylinder.action = (
+            "cylinders",
+            number,
+            marker_type.CYLINDER,
+            0,
+        )
+        cylinder.pose.position.x, cylinder.pose.position.y = shape.center
+        cylinder.pose.position.z = 0.25
+        cylinder.pose.orientation.w = 1.0
+        cylinder.scale.x = cylinder.scale.y = 2 * shape.radius
+        cylinder.scale.z = 0.5
+        cylinder.color.r = cylinder.color.g = cylinder.color.b = 0.45
+        cylinder.color.a = 1.0
+        cylinder.text = shape.name
+        markers.append(cylinder)
+    return msg("visualization_msgs/msg/MarkerArray")(markers=markers)
+
+
+def robot_description(spec: RobotSpec) -> Any:
+    """std_msgs/String with a URDF of the robot model (links, fixed and wheel joints)."""
+    return msg("std_msgs/msg/String")(data=urdf(spec.model))
+
+
+def urdf(model: RobotModel) -> str:
+    """A URDF document of a robot model: its frames as links, with the footprint drawn."""
+    foot = model.footprint
+    if isinstance(foot, Circle):
+        geometry = f'<cylinder radius="{foot.radius:g}" length="0.1"/>'
+    else:
+        xs = [p[0] for p in foot.points]
+        ys = [p[1] for p in foot.points]
+        geometry = f'<box size="{max(xs) - min(xs):g} {max(ys) - min(ys):g} 0.1"/>'
+    links = [model.base_frame, *(f.name for f in model.frames)]
+    lines = ['<?xml version="1.0"?>', f"<robot name={quoteattr(model.name)}>"]
+    for link in dict.fromkeys(links):
+        if link == model.base_frame:
+            lines.append(
+                f'  <link name={quoteattr(link)}><visual><origin xyz="0 0 0.05"/>'
+                f"<geometry>{geometry}</geometry></visual></link>"
+            )
+        else:
+            lines.append(f"  <link name={quoteattr(link)}/>")
+    for frame in model.frames:
+        kind = "continuous" if frame.joint else "fixed"
+        name = frame.joint or f"{frame.name}_joint"
+        axis = '<axis xyz="0 0 1"/>' if frame.joint else ""
+        xyz = " ".join(f"{v:g}" for v in frame.xyz)
+        rpy = " ".join(f"{v:g}" for v in frame.rpy)
+        lines.append(
+            f'  <joint name={quoteattr(name)} type="{kind}">'
+            f"<parent link={quoteattr(frame.parent)}/><child link={quoteattr(frame.name)}/>"
+            f'<origin xyz="{xyz}" rpy="{rpy}"/>{axis}</joint>'
+        )
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,113 @@
+"""A differential-drive robot: commanded through pymunk's velocity function, never tunnelling.
+
+The command is clamped to the model's limits and ramped at its acceleration limit; each
+physics step sets the body's velocity from inside ``velocity_func``, so pymunk's contact
+solver still stops the robot at walls (writing velocities before ``step()`` would tunnel).
+Odometry is the body's motion relative to its spawn pose, in the ``odom`` frame.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import pymunk
+
+from rosl.sim.world import _pymunk_shape
+from rosl.sim.worldfile import Circle, Polygon
+
+if TYPE_CHECKING:
+    from rosl.sim.worldfile import RobotSpec
+
+ABSURD = 1e3  # m/s or rad/s: a command beyond this is a bug upstream, not a wish
+
+
+class DiffDriveRobot:
+    """One robot in a pymunk space."""
+
+    def __init__(self, spec: RobotSpec, space: pymunk.Space) -> None:
+        self.spec = spec
+        model = spec.model
+        foot = model.footprint
+        if isinstance(foot, Circle):
+            moment = pymunk.moment_for_circle(model.mass, 0, foot.radius)
+        else:
+            assert isinstance(foot, Polygon)
+            moment = pymunk.moment_for_poly(model.mass, list(foot.points))
+        self.body = pymunk.Body(model.mass, moment)
+        self.body.position = spec.pose[:2]
+        self.body.angle = spec.pose[2]
+        self.shape = _pymunk_shape(self.body, foot, local=True)
+        self.shape.friction = 0.0
+        space.add(self.body, self.shape)
+        self.body.velocity_func = self._velocity
+        self.target = (0.0, 0.0)
+        self.v = 0.0
+        self.w = 0.0
+        self.wheels = [0.0, 0.0]  # left, right joint angles (rad)
+        self.wheel_rates = [0.0, 0.0]  # left, right joint speeds (rad/s)
+        self.collisions = 0
+        self._alpha = 2.0 * model.max_linear_accel / model.wheel_separation
+
+    def command(self, linear: float, angular: float) -> str | None:
+        """Set the velocity command; return a warning text when it had to be clamped or dropped."""
+        model = self.spec.model
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return (
+                f"ignored a cmd_vel with non-finite values (linear.x={linear}, angular.z={angular})"
+            )
+        if abs(linear) > ABSURD or abs(angular) > ABSURD:
+            return f"ignored an absurd cmd_vel (linear.x={linear}, angular.z={angular})"
+        clamped = (
+            max(-model.max_linear, min(model.max_linear, linear)),
+            max(-model.max_angular, min(model.max_angular, angular)),
+        )
+        self.target = clamped
+        if clamped != (linear, angular):
+            return (
+                f"clamped cmd_vel ({linear:g}, {angular:g}) to the {model.name}'s limits "
+                f"({clamped[0]:g}, {clamped[1]:g})"
+            )
+        return None
+
+    def _velocity(
+        self, body: pymunk.Body, gravity: tuple[float, float], damping: float, dt: float
+    ) -> None:
+        model = self.spec.model
+        dv = model.max_linear_accel * dt
+        dw = self._alpha * dt
+        self.v += max(-dv, min(dv, self.target[0] - self.v))
+        self.w += max(-dw, min(dw, self.target[1] - self.w))
+        angle = body.angle
+        body.velocity = (self.v * math.cos(angle), self.v * math.sin(angle))
+        body.angular_velocity = self.w
+
+    def after_step(self, dt: float) -> None:
+        """Advance the wheel joints with the motion the solver allowed."""
+        model = self.spec.model
+        angle = self.body.angle
+        vx, vy = self.body.velocity
+        forward = vx * math.cos(angle) + vy * math.sin(angle)
+        w = self.body.angular_velocity
+        half = model.wheel_separation / 2
+        left = (forward - w * half) / model.wheel_radius
+        right = (forward + w * half) / model.wheel_radius
+        self.wheel_rates[0], self.wheel_rates[1] = left, right
+        self.wheels[0] += left * dt
+        self.wheels[1] += right * dt
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """(x, y, yaw) in the world."""
+        x, y = self.body.position
+        return (x, y, self.body.angle)
+
+    def odometry(self) -> tuple[tuple[float, float, float], tuple[float, float]]:
+        """((x, y, yaw) in the odom frame, (forward speed, yaw rate))."""
+        x0, y0, yaw0 = self.spec.pose
+        x, y, yaw = self.pose
+        c, s = math.cos(-yaw0), math.sin(-yaw0)
+        dx, dy = x - x0, y - y0
+        vx, vy = self.body.velocity
+        forward = vx * math.cos(yaw) + vy * math.sin(yaw)
+        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (forward, self.body.angular_velocity)

@@ -1,0 +1,512 @@
+"""The sim node: a :class:`Simulation` on the bus, paced, free-running or in lock-step.
+
+It publishes ``/clock`` every physics step, and per robot odometry with ``odom ->
+base_footprint`` on ``/tf``, joint states (and the wheels on ``/tf``, as robot_state_publisher
+would), scans, and once (transient local) ``/tf_static``, ``robot_description`` and the
+world's geometry on ``/world_markers``; it drives each robot from its ``cmd_vel``. A topic
+nobody subscribes to is not computed nor sent (except ``/clock``): skipping it changes
+nothing else that is published.
+
+Modes: paced at ``real_time_factor`` x wall time (default 1); ``fast``: lock-step (see
+:mod:`rosl.node.lockstep`) - each step's messages are handled by the controllers before the
+next step, so the run does not depend on the machine's speed. Within a step the sensor
+messages go out before ``/clock``, so a timer woken by the new time sees the step's data.
+With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from rosl.graph.records import SUBSCRIPTION
+from rosl.sim import messages as build
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.bag.recorder import Recorder
+    from rosl.node.lockstep import LockstepSource
+    from rosl.node.node import Node
+    from rosl.node.publisher import Publisher
+    from rosl.sim.simulation import SimRobot, Simulation
+
+NS = 1_000_000_000
+
+
+@dataclass(slots=True)
+class SimOptions:
+    """How to run a simulation (``rosl sim``'s options)."""
+
+    real_time_factor: float = 1.0
+    fast: bool = False
+    duration: float | None = None
+    record: Path | None = None
+    render: Path | None = None
+    headless: bool = False
+    wait_for: list[str] = field(default_factory=list)
+    startup_timeout: float = 10.0
+    lockstep_timeout: float = 5.0
+    on_stall: str = "continue"
+
+
+@dataclass(slots=True)
+class RobotReport:
+    """What one robot did."""
+
+    name: str
+    distance: float
+    closest: float
+    collisions: int
+    pose: tuple[float, float, float]
+
+
+@dataclass(slots=True)
+class SimReport:
+    """What a run did, for the summary."""
+
+    world: str
+    sim_seconds: float
+    wall_seconds: float
+    mode: str
+    robots: list[RobotReport]
+    recorded: dict[str, int] = field(default_factory=dict)
+    bag: Path | None = None
+    picture: Path | None = None
+    stalls: int = 0
+    warnings: list[str] = field(default_factory=list)
+
+    def lines(self) -> list[str]:
+        """The summary printed at the end of a run."""
+        factor = self.sim_seconds / self.wall_seconds if self.wall_seconds > 0 else math.inf
+        out = [
+            f"simulated {self.sim_seconds:.2f} s of {self.world} in {self.wall_seconds:.2f} s "
+            f"({factor:.1f}x real time, {self.mode})"
+        ]
+        for robot in self.robots:
+            closest = (
+                "nothing within 5 m" if math.isinf(robot.closest) else (f"{robot.closest:.2f} m")
+            )
+            hits = (
+                "no collisions"
+                if robot.collisions == 0
+                else (f"{robot.collisions} collision{'s' if robot.collisions != 1 else ''}")
+            )
+            x, y, yaw = robot.pose
+            out.append(
+                f"  {robot.name}: drove {robot.distance:.2f} m, closest approach to an obstacle "
+                f"{closest}, {hits}; ends at x={x:.2f} y={y:.2f} yaw={yaw:.2f}"
+            )
+        out += [f"  cmd_vel {warning}" for warning in self.warnings]
+        if self.stalls:
+            out.append(f"  lock-step: went on without a silent controller {self.stalls} time(s)")
+        if self.bag is not None:
+            total = sum(self.recorded.values())
+            out.append(f"  recorded {total} messages to {self.bag}/:")
+            width = max((len(t) for t in self.recorded), default=0)
+            out += [f"    {t:<{width}}  {n}" for t, n in sorted(self.recorded.items())]
+        if self.picture is not None:
+            out.append(f"  picture of the run: {self.picture}")
+        return out
+
+
+class _Topic:
+    """A publisher that is only fed while someone subscribes (or always, when forced)."""
+
+    def __init__(self, sim_node: SimNode, publisher: Publisher, always: bool = False) -> None:
+        self.sim_node = sim_node
+        self.publisher = publisher
+        self.always = always
+
+    def wanted(self) -> bool:
+        return self.always or self.sim_node.subscribed(self.publisher.topic)
+
+    def send(self, message: Any) -> None:
+        self.publisher.publish(message)
+        if self.sim_node.lockstep is not None:
+            self.sim_node.lockstep.published(self.publisher)
+
+
+@dataclass(slots=True)
+class _RobotTopics:
+    sim_robot: SimRobot
+    odom: _Topic
+    joints: _Topic | None
+    scans: list[_Topic]
+    description: Publisher
+
+
+class SimNode:
+    """Runs a simulation as the node ``sim``."""
+
+    def __init__(
+        self,
+        sim: Simulation,
+        node: Node,
+        options: SimOptions,
+        *,
+        publish_all: bool = False,
+        log: Callable[[str], None] | None = None,
+    ) -> None:
+        from geometry_msgs.msg import Twist
+
+        from rosl.node.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
+
+        self.sim = sim
+        self.node = node
+        self.options = options
+        self._log = log or (lambda line: print(line, file=sys.stderr, flush=True))
+        self.lockstep: LockstepSource | None = None
+        self.recorder: Recorder | None = None
+        self._publish_all = publish_all
+        self._counts: dict[str, int] = {}
+        self._generation = -1
+        self._warned: dict[str, int] = {}
+        self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.clock = _Topic(
+            self,
+            node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
+            always=True,
+        )
+        self.tf = _Topic(
+            self, node.create_publisher(build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100)
+        )
+        self.tf_static = node.create_publisher(
+            build.msg("tf2_msgs/msg/TFMessage"), "/tf_static", latched
+        )
+        self.markers = node.create_publisher(
+            build.msg("visualization_msgs/msg/MarkerArray"), "/world_markers", latched
+        )
+        self.robots: list[_RobotTopics] = []
+        for sim_robot in sim.robots:
+            spec = sim_robot.robot.spec
+            model = spec.model
+            prefix = f"/{spec.namespace}" if spec.namespace else ""
+            node.create_subscription(
+                Twist, f"{prefix}/{model.cmd_vel}", self._on_cmd_vel(sim_robot), 10
+            )
+            odom = _Topic(
+                self,
+                node.create_publisher(
+                    build.msg("nav_msgs/msg/Odometry"), f"{prefix}/{model.odom_topic}", 10
+                ),
+            )
+            joints = None
+            if model.joint_states_topic:
+                joints = _Topic(
+                    self,
+                    node.create_publisher(
+                        build.msg("sensor_msgs/msg/JointState"),
+                        f"{prefix}/{model.joint_states_topic}",
+                        10,
+                    ),
+                )
+            scans = [
+                _Topic(
+                    self,
+                    node.create_publisher(
+                        build.msg("sensor_msgs/msg/LaserScan"),
+                        f"{prefix}/{lidar.topic}",
+                        qos_profile_sensor_data,
+                    ),
+                )
+                for lidar in model.lidars
+            ]
+            description = node.create_publisher(
+                build.msg("std_msgs/msg/String"), f"{prefix}/robot_description", latched
+            )
+            self.robots.append(_RobotTopics(sim_robot, odom, joints, scans, description))
+
+    # --- bus helpers -------------------------------------------------------------------------
+
+    def subscribed(self, topic: str) -> bool:
+        """Whether anything (a node, a recorder) subscribes to ``topic``."""
+        if self._publish_all:
+            return True
+        graph = self.node.participant.graph
+        if graph.generation != self._generation:
+            self._generation = graph.generation
+            self._counts = {}
+            for _, endpoint in graph.endpoints(SUBSCRIPTION):
+                self._counts[endpoint.name] = self._counts.get(endpoint.name, 0) + 1
+        return self._counts.get(topic, 0) > 0
+
+    def _on_cmd_vel(self, sim_robot: SimRobot) -> Callable[[Any], None]:
+        def take(message: Any) -> None:
+            warning = sim_robot.robot.command(message.linear.x, message.angular.z)
+            if warning is not None:
+                self._warn(f"{sim_robot.name}: {warning}")
+
+        return take
+
+    def _warn(self, text: str) -> None:
+        kind = text.split("(")[0]
+        self._warned[kind] = self._warned.get(kind, 0) + 1
+        if self._warned[kind] == 1:  # once per kind; the summary counts the rest
+            self.node.get_logger().warn(f"{text}; further ones are counted, not shown")
+
+    # --- publishing --------------------------------------------------------------------------
+
+    def publish_static(self) -> None:
+        """``/tf_static``, each robot's description and the world's markers (transient local)."""
+        now = self.sim.now_ns
+        self.tf_static.publish(build.static_tf(self.sim.world, now))
+        self.markers.publish(build.world_markers(self.sim.world, now))
+        for topics in self.robots:
+            topics.description.publish(build.robot_description(topics.sim_robot.robot.spec))
+
+    def tick(self) -> None:
+        """Publish what is due at the current sim time; ``/clock`` last."""
+        sim = self.sim
+        now = sim.now_ns
+        sampled = False
+        for topics in self.robots:
+            sim_robot = topics.sim_robot
+            if sim_robot.odom.due(now):
+                sim_robot.odom.fire(now)
+                if not sampled:
+                    sim.sample()
+                    sampled = True
+                if topics.odom.wanted():
+                    topics.odom.send(build.odometry(sim_robot, now))
+                if self.tf.wanted():
+                    self.tf.send(build.odom_tf(sim_robot, now))
+            if sim_robot.joints is not None and sim_robot.joints.due(now):
+                sim_robot.joints.fire(now)
+                if topics.joints is not None and topics.joints.wanted():
+                    topics.joints.send(build.joint_states(sim_robot, now))
+                wheels = build.wheel_tf(sim_robot, now) if self.tf.wanted() else None
+                if wheels is not None:
+                    self.tf.send(wheels)
+            for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
+                if schedule.due(now):
+                    index = schedule.fire(now)
+                    if topic.wanted() or self.options.render is not None:
+                        ranges = sim.scan(sim_robot, lidar, index)
+                        if topic.wanted():
+                            topic.send(build.laser_scan(lidar, ranges, now))
+        self.clock.send(build.clock(now))
+
+    # --- running -----------------------------------------------------------------------------
+
+    def run(self) -> SimReport:
+        """Run until the duration is reached or the context shuts down; return the report."""
+        from rosl.node.lockstep import LockstepSource
+
+        options = self.options
+        participant = self.node.participant
+        if options.record is not None:
+            self._start_recorder(options.record)
+        if options.fast:
+            self.lockstep = LockstepSource(
+                participant,
+                timeout=options.lockstep_timeout,
+                on_stall=options.on_stall,
+                log=lambda line: self.node.get_logger().warn(line),
+            )
+            for publisher in [self.clock, self.tf] + [
+                t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t
+            ]:
+                self.lockstep.mark(publisher.publisher)
+        self.publish_static()
+        self._wait_for_peers()
+        end_ns = None if options.duration is None else round(options.duration * NS)
+        context = self.node.context
+        started = time.monotonic()
+        status_at = started + 1.0
+        live = not options.headless and sys.stderr.isatty()
+        self.tick()
+        while context.ok():
+            self._settle()
+            if end_ns is not None and self.sim.now_ns >= end_ns:
+                break
+            if not options.fast:
+                self._pace(started)
+            self.sim.step()
+            self.tick()
+            if live and time.monotonic() >= status_at:
+                status_at += 1.0
+                self._status(started)
+        wall = time.monotonic() - started
+        if live:
+            sys.stderr.write("\n")
+        return self._finish(wall)
+
+    def _settle(self) -> None:
+        """After a step's messages went out: wait (lock-step) and record."""
+        replies: list[tuple[int, int, int, int]] = []
+        if self.lockstep is not None:
+            replies = self.lockstep.wait(self.sim.now_ns)
+            self.lockstep.settle(replies)
+        else:
+            self.node.participant.poll(0.0)
+        recorder = self.recorder
+        if recorder is not None and recorder.participant is not None:
+            own = self._own_sent()
+            expected = [*replies, *own]
+            lockstep = self.lockstep
+            check = (
+                (lambda: lockstep.caught_up(recorder.participant, expected))
+                if (lockstep is not None)
+                else None
+            )
+            recorder.record_at(self.sim.now_ns, check)
+
+    def _own_sent(self) -> list[tuple[int, int, int, int]]:
+        """The sim's own messages sent since the last call (the recorder must have them)."""
+        participant = self.node.participant
+        sent = []
+        for writer in participant.writers:
+            if writer.last_seq != self._told.get(id(writer), 0):
+                self._told[id(writer)] = writer.last_seq
+                sent.append((participant.sender, writer.topic, writer.endpoint, writer.last_seq))
+        return sent
+
+    def _pace(self, started: float) -> None:
+        """Real-time factor pacing: serve the bus until the next step is due in wall time."""
+        factor = self.options.real_time_factor
+        due = started + (self.sim.now_ns + self.sim.step_ns) / NS / factor
+        participant = self.node.participant
+        while True:
+            remaining = due - time.monotonic()
+            if remaining <= 0:
+                return
+            participant.poll(remaining)
+
+    def _wait_for_peers(self) -> None:
+        """Lock-step: start when the named nodes (or a publisher of each cmd_vel) are up."""
+        if self.lockstep is None:
+            return
+        graph = self.node.participant.graph
+        names = [n if n.startswith("/") else f"/{n}" for n in self.options.wait_for]
+        cmd_topics = [
+            (f"/{t.sim_robot.robot.spec.namespace}" if t.sim_robot.robot.spec.namespace else "")
+            + f"/{t.sim_robot.robot.spec.model.cmd_vel}"
+            for t in self.robots
+        ]
+
+        def ready() -> bool:
+            answering = {p.sender for p in graph.processes() if p.lockstep}
+            if names:
+                up = {n.fqn for n in graph.nodes() if n.process in answering}
+                return all(name in up for name in names)
+            from rosl.graph.records import PUBLISHER
+
+            return all(
+                any(node.process in answering for node, _ in graph.endpoints(PUBLISHER, topic))
+                for topic in cmd_topics
+            )
+
+        if ready():
+            return
+        what = ", ".join(names) if names else "a node publishing " + ", ".join(cmd_topics)
+        self.node.get_logger().info(
+            f"lock-step: waiting for {what} (up to {self.options.startup_timeout:g} s)"
+        )
+        deadline = time.monotonic() + self.options.startup_timeout
+        while not ready() and time.monotonic() < deadline and self.node.context.ok():
+            self.node.participant.poll(0.05)
+        if not ready():
+            self.node.get_logger().warn(
+                f"lock-step: {what} did not come up in {self.options.startup_timeout:g} s; "
+                "starting without it"
+            )
+
+    def _start_recorder(self, folder: Path) -> None:
+        from rosl.bag.recorder import Recorder
+
+        def log(line: str) -> None:
+            if not line.startswith("[INFO]"):
+                self._log(line)
+
+        participant = self.node.participant
+        self._told = {id(w): w.last_seq for w in participant.writers}  # before the recorder
+        self.recorder = Recorder(
+            folder,
+            domain=self.node.participant.transport.addressing.domain,
+            compression="zstd",
+            log=log,
+        )
+        self.recorder.start()
+
+    def _status(self, started: float) -> None:
+        wall = time.monotonic() - started
+        sim_s = self.sim.now_ns / NS
+        sys.stderr.write(f"\r[sim] t={sim_s:8.2f} s  {sim_s / wall if wall else 0:6.1f}x real time")
+        sys.stderr.flush()
+
+    def _finish(self, wall: float) -> SimReport:
+        options = self.options
+        recorded: dict[str, int] = {}
+        if self.recorder is not None:
+            self.recorder.close()
+            recorded = {
+                name: t.info.count for name, t in self.recorder._topics.items() if t.info.count
+            }
+        mode = "lock-step" if options.fast else f"paced at {options.real_time_factor:g}x"
+        report = SimReport(
+            world=self.sim.world.name,
+            sim_seconds=self.sim.now_ns / NS,
+            wall_seconds=wall,
+            mode=mode,
+            robots=[
+                RobotReport(r.name, r.distance, r.closest, r.collisions, r.robot.pose)
+                for r in self.sim.robots
+            ],
+            recorded=recorded,
+            bag=options.record,
+            stalls=self.lockstep.stalls if self.lockstep is not None else 0,
+            warnings=[f"{kind.strip()}: {count} time(s)" for kind, count in self._warned.items()],
+        )
+        if options.render is not None:
+            from rosl.sim.render import render_simulation
+
+            report.picture = render_simulation(self.sim, options.render)
+        return report
+
+
+def parse_arguments(argv: list[str]) -> tuple[Path, SimOptions, int | None]:
+    """``sim WORLD [options]`` as the executable of package rosl_sim takes them."""
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="sim", description="rosl's 2D simulator as a node")
+    parser.add_argument("world")
+    parser.add_argument("--real-time-factor", type=float, default=1.0)
+    parser.add_argument("--fast", action="store_true")
+    parser.add_argument("--duration", type=float)
+    parser.add_argument("--seed", type=int)
+    parser.add_argument("--record", type=Path)
+    parser.add_argument("--render", type=Path)
+    parser.add_argument("--headless", action="store_true")
+    parser.add_argument("--wait-for", action="append", default=[])
+    parser.add_argument("--startup-timeout", type=float, default=10.0)
+    parser.add_argument("--lockstep-timeout", type=float, default=5.0)
+    parser.add_argument("--on-stall", choices=["continue", "stop"], default="continue")
+    args = parser.parse_args(argv)
+    options = SimOptions(
+        real_time_factor=args.real_time_factor,
+        fast=args.fast,
+        duration=args.duration,
+        record=args.record,
+        render=args.render,
+        headless=args.headless,
+        wait_for=args.wait_for,
+        startup_timeout=args.startup_timeout,
+        lockstep_timeout=args.lockstep_timeout,
+        on_stall=args.on_stall,
+    )
+    return Path(args.world), options, args.seed
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``rosl run rosl_sim sim WORLD ...`` (and of ``rosl sim``)."""
+    from rosl.sim.runner import run_sim
+
+    if argv is None:
+        argv = sys.argv[1:]
+    return run_sim(argv)

@@ -1,0 +1,176 @@
+"""A world file as a pymunk space, plus the flat geometry that ray casting uses."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pymunk
+
+from rosl.sim.worldfile import Circle, Polygon, RobotSpec, Segment, Shape
+
+if TYPE_CHECKING:
+    from rosl.sim.worldfile import World
+
+
+def _pymunk_shape(body: pymunk.Body, shape: Shape, *, local: bool = False) -> pymunk.Shape:
+    """A pymunk shape on ``body`` (world coordinates, or body-local when ``local``)."""
+    if isinstance(shape, Circle):
+        offset = (0.0, 0.0) if local else shape.center
+        return pymunk.Circle(body, shape.radius, offset)
+    if isinstance(shape, Polygon):
+        return pymunk.Poly(body, list(shape.points))
+    return pymunk.Segment(body, shape.a, shape.b, shape.radius)
+
+
+def footprint_overlaps(robot: RobotSpec, statics: tuple[Shape, ...]) -> str | None:
+    """The name of a static shape the robot's spawn footprint overlaps, if any."""
+    space = pymunk.Space()
+    names: dict[pymunk.Shape, str] = {}
+    for shape in statics:
+        made = _pymunk_shape(space.static_body, shape)
+        names[made] = shape.name
+        space.add(made)
+    body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+    body.position = robot.pose[:2]
+    body.angle = robot.pose[2]
+    probe = _pymunk_shape(body, robot.model.footprint, local=True)
+    space.add(body, probe)
+    hits = space.shape_query(probe)
+    return names[hits[0].shape] if hits else None
+
+
+class Geometry:
+    """Obstacles as numpy arrays: edges (x1, y1, x2, y2) and circles (x, y, r).
+
+    Polygon edges run counter-clockwise, so an edge whose outside faces away from the sensor
+    (one the sensor cannot see first) can be dropped; free segments are seen from both sides.
+    """
+
+    def __init__(self, shapes: tuple[Shape, ...]) -> None:
+        segments: list[tuple[float, float, float, float]] = []
+        closed: list[bool] = []
+        circles: list[tuple[float, float, float]] = []
+        for shape in shapes:
+            if isinstance(shape, Circle):
+                circles.append((*shape.center, shape.radius))
+            elif isinstance(shape, Polygon):
+                points = list(shape.points)
+                area = sum(
+                    a[0] * b[1] - b[0] * a[1]
+                    for a, b in zip(points, points[1:] + points[:1], strict=True)
+                )
+                if area < 0:
+                    points.reverse()
+                for k, (x1, y1) in enumerate(points):
+                    x2, y2 = points[(k + 1) % len(points)]
+                    segments.append((x1, y1, x2, y2))
+                    closed.append(True)
+            elif isinstance(shape, Segment):
+                segments.append((*shape.a, *shape.b))
+                closed.append(False)
+        self.segments = np.array(segments, dtype=np.float64).reshape(-1, 4)
+        self.closed = np.array(closed, dtype=bool)
+        self.circles = np.array(circles, dtype=np.float64).reshape(-1, 3)
+
+    def near(
+        self, x: float, y: float, reach: float, *, facing: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The segments and circles that could be hit within ``reach`` of (x, y).
+
+        With ``facing``, polygon edges whose outside faces away from (x, y) are left out.
+        """
+        seg = self.segments
+        if len(seg):
+            ex, ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
+            length2 = np.maximum(ex * ex + ey * ey, 1e-18)
+            t = np.clip(((x - seg[:, 0]) * ex + (y - seg[:, 1]) * ey) / length2, 0.0, 1.0)
+            dx, dy = seg[:, 0] + t * ex - x, seg[:, 1] + t * ey - y
+            keep = dx * dx + dy * dy <= reach * reach
+            if facing:  # outward normal of a ccw edge is (ey, -ex); the sensor must be outside
+                outside = (x - seg[:, 0]) * ey - (y - seg[:, 1]) * ex > 0.0
+                keep &= outside | ~self.closed
+            seg = seg[keep]
+        cir = self.circles
+        if len(cir):
+            d = np.hypot(cir[:, 0] - x, cir[:, 1] - y) - cir[:, 2]
+            cir = cir[d <= reach]
+        return seg, cir
+
+
+class WorldSpace:
+    """The pymunk space of a world: statics, dynamic bodies, and the ray-cast geometry."""
+
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.space = pymunk.Space()
+        self.space.gravity = (0.0, 0.0)
+        self.space.iterations = world.iterations
+        for shape in world.statics:
+            made = _pymunk_shape(self.space.static_body, shape)
+            made.friction = 0.0
+            self.space.add(made)
+        self.bodies: list[tuple[pymunk.Body, Shape]] = []
+        for dynamic in world.dynamics:
+            self._add_body(dynamic.shape, dynamic.mass, dynamic.kinematic)
+        self.geometry = Geometry(world.statics)
+
+    def _add_body(self, shape: Shape, mass: float, kinematic: bool) -> None:
+        center = _centroid(shape)
+        local = _translate(shape, -center[0], -center[1])
+        if kinematic:
+            body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        else:
+            moment = (
+                pymunk.moment_for_circle(mass, 0, local.radius)
+                if isinstance(local, Circle)
+                else pymunk.moment_for_box(mass, (1.0, 1.0))
+            )
+            body = pymunk.Body(mass, moment)
+        body.position = center
+        made = _pymunk_shape(body, local, local=False)
+        made.friction = 0.5
+        self.space.add(body, made)
+        self.bodies.append((body, local))
+
+    def dynamic_geometry(self) -> Geometry:
+        """The dynamic bodies' shapes where they are now (for ray casting)."""
+        placed: list[Shape] = []
+        for body, local in self.bodies:
+            c, s = math.cos(body.angle), math.sin(body.angle)
+            px, py = body.position
+            if isinstance(local, Circle):
+                placed.append(
+                    Circle(local.name, (px + local.center[0], py + local.center[1]), local.radius)
+                )
+            elif isinstance(local, Polygon):
+                placed.append(
+                    Polygon(
+                        local.name,
+                        tuple((px + c * x - s * y, py + s * x + c * y) for x, y in local.points),
+                    )
+                )
+        return Geometry(tuple(placed))
+
+
+def _centroid(shape: Shape) -> tuple[float, float]:
+    if isinstance(shape, Circle):
+        return shape.center
+    if isinstance(shape, Polygon):
+        xs, ys = zip(*shape.points, strict=True)
+        return (sum(xs) / len(xs), sum(ys) / len(ys))
+    return ((shape.a[0] + shape.b[0]) / 2, (shape.a[1] + shape.b[1]) / 2)
+
+
+def _translate(shape: Shape, dx: float, dy: float) -> Shape:
+    if isinstance(shape, Circle):
+        return Circle(shape.name, (shape.center[0] + dx, shape.center[1] + dy), shape.radius)
+    if isinstance(shape, Polygon):
+        return Polygon(shape.name, tuple((x + dx, y + dy) for x, y in shape.points))
+    return Segment(
+        shape.name,
+        (shape.a[0] + dx, shape.a[1] + dy),
+        (shape.b[0] + dx, shape.b[1] + dy),
+        shape.radius,
+    )
