@@ -152,7 +152,11 @@ class Recorder:
             self._maybe_split(now)
 
     def record_at(
-        self, now_ns: int, caught_up: Callable[[], bool] | None = None, timeout: float = 1.0
+        self,
+        now_ns: int,
+        caught_up: Callable[[], bool] | None = None,
+        timeout: float = 1.0,
+        only_from: int | None = None,
     ) -> None:
         """Write what has arrived as of sim time ``now_ns`` (a simulator's in-process recorder).
 
@@ -160,7 +164,8 @@ class Recorder:
         written in an order that does not depend on arrival order, so the same simulation gives
         the same bag. ``caught_up`` says when everything expected has arrived (bounded by
         ``timeout``). Chunks close every second of sim time; the file is fsynced at most once
-        a second of wall time.
+        a second of wall time. ``only_from`` keeps only one process's messages (what came
+        before a simulation started is left out, since its timing is not reproducible).
         """
         assert self.participant is not None
         self.sim_time = True
@@ -170,6 +175,8 @@ class Recorder:
         while caught_up is not None and not caught_up() and time.monotonic() < deadline:
             self.participant.poll(0.002, sink=arrived.append)
         self._sync_graph()
+        if only_from is not None:
+            arrived = [d for d in arrived if d.sender == only_from]
         arrived.sort(key=_arrival_free_order)
         for delivery in arrived:
             self._on_delivery(delivery._replace(received=now_ns, stamp=now_ns))

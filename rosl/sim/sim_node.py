@@ -167,6 +167,7 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
+        node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.clock = _Topic(
             self,
@@ -264,6 +265,7 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
+        self.node.get_clock().set_sim_now(now)
         sampled = False
         for topics in self.robots:
             sim_robot = topics.sim_robot
@@ -315,6 +317,9 @@ class SimNode:
                 self.lockstep.mark(publisher.publisher)
         self.publish_static()
         self._wait_for_peers()
+        if self.recorder is not None:  # the static messages, but nothing sent before the start
+            self.recorder.record_at(0, lambda: True, only_from=participant.sender)
+            self._own_sent()
         end_ns = None if options.duration is None else round(options.duration * NS)
         context = self.node.context
         started = time.monotonic()
@@ -405,16 +410,15 @@ class SimNode:
         if ready():
             return
         what = ", ".join(names) if names else "a node publishing " + ", ".join(cmd_topics)
-        self.node.get_logger().info(
-            f"lock-step: waiting for {what} (up to {self.options.startup_timeout:g} s)"
-        )
+        limit = f"{self.options.startup_timeout:g} s"
+        self._log(f"[INFO] [sim]: lock-step: waiting for {what} (up to {limit})")  # not /rosout
         deadline = time.monotonic() + self.options.startup_timeout
         while not ready() and time.monotonic() < deadline and self.node.context.ok():
             self.node.participant.poll(0.05)
         if not ready():
-            self.node.get_logger().warn(
-                f"lock-step: {what} did not come up in {self.options.startup_timeout:g} s; "
-                "starting without it"
+            self._log(
+                f"[WARN] [sim]: lock-step: {what} did not come up in "
+                f"{self.options.startup_timeout:g} s; starting without it"
             )
 
     def _start_recorder(self, folder: Path) -> None:
