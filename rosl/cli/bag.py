@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from rosl.cli import render
-from rosl.cli.options import domain_option
+from rosl.cli.options import GreedyOption, domain_option
 
 
 @click.group("bag")
@@ -114,3 +114,131 @@ def reindex(bag: Path) -> None:
     from rosl.bag.reindex import reindex as run
 
     render.lines(run(bag))
+
+
+@command.command("play")
+@click.argument("bag", type=click.Path(path_type=Path))
+@click.option("-r", "--rate", type=float, default=1.0, help="Rate at which to play back (> 0)")
+@click.option("-l", "--loop", is_flag=True, help="Play the bag again and again")
+@click.option(
+    "--clock",
+    type=float,
+    is_flag=False,
+    flag_value=40.0,
+    default=None,
+    help="Publish the bag's time on /clock at this rate in Hz (flag alone: 40)",
+)
+@click.option("--topics", cls=GreedyOption, multiple=True, help="Play only these topics")
+@click.option(
+    "--start-offset", type=float, default=0.0, help="Start this many seconds into the bag"
+)
+@click.option("-m", "--remap", cls=GreedyOption, multiple=True, help="Rename topics: old:=new ...")
+@click.option(
+    "--read-ahead-queue-size", type=int, default=1000, help="Messages kept read ahead (1000)"
+)
+@click.option("-p", "--start-paused", is_flag=True, help="Start paused (SPACE resumes)")
+@click.option("--disable-keyboard-controls", is_flag=True, help="Ignore SPACE and the arrow keys")
+@domain_option
+def play(bag: Path, **options: Any) -> None:
+    """Play back a bag: the recorded bytes with their original timing."""
+    import sys
+
+    from rosl.bag.player import Player, PlayOptions, parse_remap
+
+    player = Player(bag, PlayOptions(
+        rate=options["rate"], loop=options["loop"], clock_hz=options["clock"],
+        topics=options["topics"], start_offset=options["start_offset"],
+        remap=parse_remap(_flat(options["remap"])), read_ahead=options["read_ahead_queue_size"],
+        domain=options["domain_id"],
+        keyboard=not options["disable_keyboard_controls"] and sys.stdin.isatty(),
+        start_paused=options["start_paused"],
+    ), log=render.warn)  # fmt: skip
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda signum, frame: player.stop())
+    render.lines([player.play().summary()])
+
+
+@command.command("diff")
+@click.argument("golden", type=click.Path(path_type=Path))
+@click.argument("new", type=click.Path(path_type=Path))
+@click.option("--topics", cls=GreedyOption, multiple=True, help="Compare only these topics")
+@click.option("--exclude", default=None, help="Leave out topics matching this regex")
+@click.option(
+    "--tolerance", type=float, default=1e-3, help="Largest float difference accepted (1e-3)"
+)
+@click.option(
+    "--time-tolerance",
+    type=float,
+    default=None,
+    help="Largest difference of relative log times in seconds (default: not checked)",
+)
+@click.option(
+    "--ignore-field",
+    multiple=True,
+    help="Do not compare this field path (e.g. header.stamp); repeatable",
+)
+@click.option("--max-lines", type=int, default=20, help="Differences to print (20)")
+def diff(golden: Path, new: Path, **options: Any) -> int:
+    """Compare two bags message by message; exit 0 when they match, 1 when not."""
+    from rosl.bag.diff import compare
+
+    result = compare(
+        golden, new, topics=list(options["topics"]) or None, exclude=options["exclude"],
+        tolerance=options["tolerance"], time_tolerance=options["time_tolerance"],
+        ignore_fields=options["ignore_field"], limit=options["max_lines"],
+    )  # fmt: skip
+    render.text(result.text())
+    return 0 if result.matched else 1
+
+
+@command.command("filter")
+@click.argument("source", type=click.Path(path_type=Path))
+@click.argument("output", type=click.Path(path_type=Path))
+@click.option("--topics", cls=GreedyOption, multiple=True, help="Keep only these topics")
+@click.option("--exclude", default=None, help="Drop topics matching this regex")
+@click.option("--start", type=float, default=None, help="Seconds after the bag's start")
+@click.option("--end", type=float, default=None, help="Seconds after the bag's start")
+@click.option(
+    "--compression-format",
+    type=click.Choice(["zstd", "lz4", "none"]),
+    default=None,
+    help="Chunk compression of the output (default: the input's)",
+)
+def filter_(source: Path, output: Path, **options: Any) -> None:
+    """Write a new bag with the selected topics and time window of another."""
+    from rosl.bag.trim import copy
+
+    result = copy(
+        source, output, topics=list(options["topics"]) or None, exclude=options["exclude"],
+        start=options["start"], end=options["end"], compression=options["compression_format"],
+    )  # fmt: skip
+    for line in result.warnings:
+        render.warn(line)
+    render.lines([result.summary()])
+
+
+@command.command("convert")
+@click.argument("source", type=click.Path(path_type=Path))
+@click.argument("output", type=click.Path(path_type=Path))
+@click.option(
+    "--compression-format",
+    type=click.Choice(["zstd", "lz4", "none"]),
+    default=None,
+    help="Chunk compression of the output (default: the input's)",
+)
+def convert(source: Path, output: Path, compression_format: str | None) -> None:
+    """Rewrite a bag into one MCAP file (recompressed with --compression-format)."""
+    from rosl.bag.trim import copy
+
+    result = copy(source, output, compression=compression_format)
+    for line in result.warnings:
+        render.warn(line)
+    render.lines([result.summary()])
+
+
+def _flat(values: Any) -> list[str]:
+    """Flatten a GreedyOption's values (an option with two names nests them one level more)."""
+    flat: list[str] = []
+    for item in values or ():
+        flat.extend(_flat(item) if isinstance(item, tuple) else [item])
+    return flat

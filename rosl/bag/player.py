@@ -1,0 +1,489 @@
+"""``rosl bag play``: a recording put back on the bus, bytes unchanged, with its original timing.
+
+A node ``rosbag2_player`` announces one publisher per played topic (the recorded type and
+offered QoS, after ``--remap``), then each message's recorded bytes are sent when the playback
+clock reaches its log time: the clock starts at the bag's first message (plus
+``--start-offset``) and runs at ``--rate``. A reader thread keeps up to
+``--read-ahead-queue-size`` messages ready. With ``--clock`` the playback clock is published on
+``/clock`` so sim-time nodes follow the bag. On a terminal, SPACE pauses and resumes, → sends
+the next message while paused, ↑/↓ change the rate by 10%.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import os
+import queue
+import select
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from rosl.bag.errors import BagError
+from rosl.bag.reader import BagMessage, iter_bag
+from rosl.bag.trim import Scan, SourceChannel, scan, unfinished_warning
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterator
+    from pathlib import Path
+
+    from rosl.bus.wire import Writer
+    from rosl.graph.records import NodeRecord
+    from rosl.node.participant import Participant
+
+NS = 1_000_000_000
+NODE = "rosbag2_player"
+HINTS = (
+    "Adding keyboard callbacks.",
+    "Press SPACE for Pause/Resume",
+    "Press CURSOR_RIGHT for Play Next Message",
+    "Press CURSOR_UP for Increase Rate 10%",
+    "Press CURSOR_DOWN for Decrease Rate 10%",
+)
+_KEYS = {b" ": "pause", b"\x1b[C": "next", b"\x1b[A": "faster", b"\x1b[B": "slower"}
+_PASS = object()  # end of one pass through the bag (more follow with --loop)
+_DONE = object()
+
+
+@dataclass(frozen=True, slots=True)
+class PlayOptions:
+    """How to play a bag (``ros2 bag play``'s options)."""
+
+    rate: float = 1.0
+    loop: bool = False
+    clock_hz: float | None = None  # None: no /clock
+    topics: tuple[str, ...] = ()  # empty: every topic
+    start_offset: float = 0.0
+    remap: tuple[tuple[str, str], ...] = ()
+    read_ahead: int = 1000
+    domain: int | str | None = None
+    keyboard: bool = False
+    start_paused: bool = False
+    discovery_wait: float = 0.3
+
+
+@dataclass(slots=True)
+class PlayResult:
+    """What was played."""
+
+    played: dict[str, int] = field(default_factory=dict)  # topic as published -> messages
+    passes: int = 0
+    stopped: bool = False
+
+    def summary(self) -> str:
+        """One line: messages played per topic."""
+        total = sum(self.played.values())
+        topics = ", ".join(f"{name} {count}" for name, count in sorted(self.played.items()))
+        passes = f" in {self.passes} passes" if self.passes > 1 else ""
+        stopped = " (stopped)" if self.stopped else ""
+        return f"played {total} messages{passes}{stopped}" + (f": {topics}" if topics else "")
+
+
+def parse_remap(rules: list[str] | tuple[str, ...]) -> tuple[tuple[str, str], ...]:
+    """``from:=to`` rules as (from, to) pairs of absolute topic names.
+
+    Raises:
+        BagError: a rule without ``:=`` or with an empty side.
+    """
+    pairs = []
+    for rule in rules:
+        source, sep, target = rule.partition(":=")
+        if not sep or not source or not target:
+            raise BagError(f"--remap '{rule}' is not of the form from:=to")
+        pairs.append(("/" + source.lstrip("/"), "/" + target.lstrip("/")))
+    return tuple(pairs)
+
+
+class _Timeline:
+    """The playback clock: bag time that runs at ``rate`` and can pause, step and jump."""
+
+    def __init__(self, start_ns: int, rate: float) -> None:
+        self.rate = rate
+        self.paused = False
+        self._bag = start_ns
+        self._wall = time.monotonic_ns()
+
+    def now(self) -> int:
+        if self.paused:
+            return self._bag
+        return self._bag + int((time.monotonic_ns() - self._wall) * self.rate)
+
+    def jump(self, bag_ns: int) -> None:
+        self._bag, self._wall = bag_ns, time.monotonic_ns()
+
+    def set_paused(self, paused: bool) -> None:
+        self.jump(self.now())
+        self.paused = paused
+
+    def set_rate(self, rate: float) -> None:
+        self.jump(self.now())
+        self.rate = rate
+
+    def seconds_until(self, bag_ns: int) -> float:
+        if self.paused:
+            return float("inf")
+        return (bag_ns - self.now()) / self.rate / NS
+
+
+class _Outlet:
+    """The publisher of one played topic (keeps history when it was transient-local)."""
+
+    def __init__(self, writer: Writer, qos: dict[str, Any]) -> None:
+        self.writer = writer
+        self.qos = qos
+        keep = str(qos.get("durability", "")).upper() == "TRANSIENT_LOCAL"
+        depth = max(1, int(qos.get("depth", 1) or 1))
+        self.history: collections.deque[tuple[int, bytes]] | None = (
+            collections.deque(maxlen=depth) if keep else None
+        )
+
+    def send(self, data: bytes) -> None:
+        seq = self.writer.send(data)
+        if self.history is not None:
+            self.history.append((seq, data))
+
+    def replay(self, target: tuple[int, int]) -> None:
+        """Send the kept history to one late transient-local subscriber."""
+        from rosl.bus.header import Kind
+
+        for seq, data in list(self.history or ()):
+            self.writer.send(data, kind=Kind.REPLAY, address=(*target, 0), seq=seq)
+
+
+class _Keyboard:
+    """SPACE and the arrow keys, read from a terminal in cbreak mode (restored on exit)."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.fd = sys.stdin.fileno() if enabled and sys.stdin.isatty() else -1
+        self._saved: Any = None
+
+    @property
+    def active(self) -> bool:
+        return self.fd >= 0
+
+    def __enter__(self) -> _Keyboard:
+        if self.active:
+            import termios
+            import tty
+
+            self._saved = termios.tcgetattr(self.fd)
+            tty.setcbreak(self.fd)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._saved is not None:
+            import termios
+
+            termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
+            self._saved = None
+
+    def read(self, timeout: float) -> list[str]:
+        """Wait up to ``timeout`` for keys; return the commands typed."""
+        ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout))
+        if not ready:
+            return []
+        data = os.read(self.fd, 64)
+        commands = []
+        while data:
+            for key, command in _KEYS.items():
+                if data.startswith(key):
+                    commands.append(command)
+                    data = data[len(key) :]
+                    break
+            else:
+                data = data[1:]
+        return commands
+
+
+def qos_words(channel: SourceChannel) -> dict[str, Any]:
+    """Discovery's QoS words from the first offered profile the recorder wrote."""
+    first = (channel.offered_qos() or [{}])[0]
+    return {
+        "reliability": str(first.get("reliability", "reliable")).upper(),
+        "durability": str(first.get("durability", "volatile")).upper(),
+        "history": str(first.get("history", "keep_last")).upper(),
+        "depth": int(first.get("depth", 10) or 10),
+    }
+
+
+class Player:
+    """Plays one bag on the bus; :meth:`play` runs to the end (or :meth:`stop`)."""
+
+    def __init__(
+        self, bag: Path, options: PlayOptions, log: Callable[[str], None] | None = None
+    ) -> None:
+        if options.rate <= 0:
+            raise BagError(f"--rate must be greater than 0 (got {options.rate})")
+        if options.clock_hz is not None and options.clock_hz <= 0:
+            raise BagError(f"--clock must be a rate greater than 0 Hz (got {options.clock_hz:g})")
+        if options.read_ahead < 1:
+            raise BagError("--read-ahead-queue-size must be at least 1")
+        self.bag = bag
+        self.options = options
+        self._log = log or (lambda line: None)
+        self._stop = threading.Event()
+        self._queue: queue.Queue[Any] = queue.Queue(maxsize=options.read_ahead)
+        self._outlets: dict[str, _Outlet] = {}
+        self._clock: Writer | None = None
+        self._clock_message: Callable[[int], bytes] = lambda bag_ns: b""
+        self._next_tick = 0.0
+        self._step = False
+        self._index = 0
+        self.participant: Participant | None = None
+        self.result = PlayResult()
+
+    def stop(self) -> None:
+        """Ask playback to end (safe from a signal handler)."""
+        self._stop.set()
+
+    def play(self) -> PlayResult:
+        """Play the bag; return what was played.
+
+        Raises:
+            BagError: the bag cannot be read.
+        """
+        keys = _Keyboard(self.options.keyboard)
+        if self.options.start_paused and not keys.active:
+            raise BagError("--start-paused needs the keyboard: stdin is not a terminal")
+        found = scan(self.bag)
+        for path in found.unfinished:
+            self._log(unfinished_warning(path))
+        wanted = self._select(found)
+        remap = dict(self.options.remap)
+        start = found.start_ns + round(self.options.start_offset * NS)
+        reader = threading.Thread(target=self._produce, args=(wanted, start), daemon=True)
+        try:
+            self._join(found, wanted, remap)
+            reader.start()
+            with keys:
+                self._log(f"[INFO] [{NODE}]: Set rate to {self.options.rate:g}")
+                for line in HINTS if keys.active else ():
+                    self._log(f"[INFO] [{NODE}]: {line}")
+                count = sum(found.channels[t].count for t in wanted)
+                seconds = (found.end_ns - found.start_ns) / NS
+                self._log(f"[INFO] [{NODE}]: Playing {count} messages on {len(wanted)} topics "
+                          f"({seconds:.1f} s of recording)")  # fmt: skip
+                self._run(keys, start, remap)
+        finally:
+            self._stop.set()
+            with contextlib.suppress(queue.Empty):
+                while True:
+                    self._queue.get_nowait()
+            if self.participant is not None:
+                self.participant.close()
+        return self.result
+
+    # --- setup -------------------------------------------------------------------------------
+
+    def _select(self, found: Scan) -> set[str]:
+        if not self.options.topics:
+            return set(found.channels)
+        names = {"/" + name.lstrip("/") for name in self.options.topics}
+        for name in sorted(names - set(found.channels)):
+            self._log(f"[WARN] [{NODE}]: topic {name} is not in the bag")
+        return names & set(found.channels)
+
+    def _join(self, found: Scan, wanted: set[str], remap: dict[str, str]) -> None:
+        """Join the bus as rosbag2_player with a publisher per topic; let discovery settle."""
+        from rosl.bus.wire import Writer
+        from rosl.node.participant import Participant
+
+        participant = self.participant = Participant(self.options.domain)
+        for topic in sorted(wanted):
+            channel = found.channels[topic]
+            name = remap.get(topic, topic)
+            writer = Writer(
+                participant.transport, participant.sender, participant.next_endpoint(),
+                name, channel.type,
+            )  # fmt: skip
+            outlet = self._outlets[topic] = _Outlet(writer, qos_words(channel))
+            if outlet.history is not None:
+                participant.add_replayer(name, outlet)
+        if self.options.clock_hz is not None:
+            self._clock_message = _clock_serializer()
+            self._clock = Writer(
+                participant.transport, participant.sender, participant.next_endpoint(),
+                "/clock", "rosgraph_msgs/msg/Clock",
+            )  # fmt: skip
+        self._answer_typedefs(found)
+        self._index = participant.add_node(lambda: self._describe(found, remap))
+        participant.discovery.changed()
+        participant.discovery.wait_complete(participant.discovery.query(), timeout=1.0)
+        self._stop.wait(self.options.discovery_wait)
+
+    def _describe(self, found: Scan, remap: dict[str, str]) -> NodeRecord:
+        from rosl.graph.records import PUBLISHER, EndpointRecord, NodeRecord
+
+        assert self.participant is not None
+        endpoints = [
+            EndpointRecord(PUBLISHER, remap.get(topic, topic), found.channels[topic].type,
+                           outlet.writer.endpoint, outlet.qos, {"sent": outlet.writer.sent})
+            for topic, outlet in self._outlets.items()
+        ]  # fmt: skip
+        if self._clock is not None:
+            qos = {"reliability": "RELIABLE", "durability": "VOLATILE", "depth": 10}
+            endpoints.append(
+                EndpointRecord(PUBLISHER, "/clock", "rosgraph_msgs/msg/Clock",
+                               self._clock.endpoint, qos, {"sent": self._clock.sent})
+            )  # fmt: skip
+        return NodeRecord(NODE, "/", self.participant.sender, self._index, tuple(endpoints))
+
+    def _answer_typedefs(self, found: Scan) -> None:
+        """Describe the bag's types to recorders that ask (they may not know them locally)."""
+        assert self.participant is not None
+        discovery = self.participant.discovery
+        previous = discovery.handlers.get("typedef_request")
+        hashes = {
+            e["topic_metadata"]["type"]: e["topic_metadata"].get("type_description_hash", "")
+            for e in (found.info or {}).get("topics_with_message_count", [])
+        }
+        schemas = {c.type: c for c in found.channels.values() if c.schema_encoding}
+
+        def answer(message: dict[str, Any]) -> None:
+            channel = schemas.get(str(message.get("type")))
+            if channel is None:
+                if previous is not None:
+                    previous(message)
+                return
+            discovery.send({
+                "op": "typedef", "type": channel.type, "encoding": channel.schema_encoding,
+                "text": channel.schema_data.decode(errors="replace"),
+                "hash": hashes.get(channel.type, ""),
+            })  # fmt: skip
+
+        discovery.handlers["typedef_request"] = answer
+
+    # --- reading -----------------------------------------------------------------------------
+
+    def _produce(self, wanted: set[str], start: int) -> None:
+        """The read-ahead thread: every pass of the bag into the queue."""
+        try:
+            while not self._stop.is_set():
+                count = 0
+                for message in self._messages(wanted, start):
+                    if not self._put(message):
+                        return
+                    count += 1
+                if not (self.options.loop and count):
+                    break
+                if not self._put(_PASS):
+                    return
+            self._put(_DONE)
+        except Exception as err:
+            self._put(err)
+
+    def _messages(self, wanted: set[str], start: int) -> Iterator[BagMessage]:
+        from mcap.exceptions import McapError
+
+        if not wanted:
+            return
+        try:
+            for message in iter_bag(self.bag, wanted):
+                if message.log_time >= start:
+                    yield message
+        except McapError as err:
+            raise BagError(f"cannot read {self.bag}: {err}") from None
+
+    def _put(self, item: object) -> bool:
+        while not self._stop.is_set():
+            try:
+                self._queue.put(item, timeout=0.1)
+            except queue.Full:
+                continue
+            return True
+        return False
+
+    # --- playing -----------------------------------------------------------------------------
+
+    def _run(self, keys: _Keyboard, start: int, remap: dict[str, str]) -> None:
+        item = self._take(keys, None)  # the first message is read before the clock starts
+        timeline = _Timeline(start, self.options.rate)
+        timeline.paused = self.options.start_paused
+        self.result.passes = 1
+        self._tick(timeline, force=True)
+        while item is not None and item is not _DONE:
+            if item is _PASS:
+                self.result.passes += 1
+                self._log(f"[INFO] [{NODE}]: Loop: pass {self.result.passes}")
+                timeline.jump(start)
+            elif isinstance(item, BaseException):
+                raise item
+            elif self._wait_for(item.log_time, keys, timeline):
+                self._outlets[item.topic].send(item.data)
+                name = remap.get(item.topic, item.topic)
+                self.result.played[name] = self.result.played.get(name, 0) + 1
+            item = self._take(keys, timeline)
+        self.result.stopped = self._stop.is_set()
+
+    def _take(self, keys: _Keyboard, timeline: _Timeline | None) -> Any:
+        """The next item read ahead (None once stopped)."""
+        while not self._stop.is_set():
+            try:
+                return self._queue.get(timeout=0.05)
+            except queue.Empty:
+                if timeline is not None:
+                    self._service(keys, timeline, 0.0)
+        return None
+
+    def _wait_for(self, bag_ns: int, keys: _Keyboard, timeline: _Timeline) -> bool:
+        """Wait until the playback clock reaches ``bag_ns`` (or → is pressed while paused)."""
+        while not self._stop.is_set():
+            remaining = timeline.seconds_until(bag_ns)
+            if self._step:
+                self._step = False
+                timeline.jump(max(bag_ns, timeline.now()))
+                return True
+            if remaining <= 0:
+                return True
+            self._service(keys, timeline, min(remaining, 0.05))
+        return False
+
+    def _service(self, keys: _Keyboard, timeline: _Timeline, timeout: float) -> None:
+        """Publish /clock when due; read keys (or sleep) for up to ``timeout``."""
+        self._tick(timeline)
+        if self._clock is not None:
+            timeout = min(timeout, max(0.0, self._next_tick - time.monotonic()))
+        if not keys.active:
+            if timeout > 0:
+                self._stop.wait(timeout)
+            return
+        for command in keys.read(timeout):
+            if command == "pause":
+                timeline.set_paused(not timeline.paused)
+                self._log(f"[INFO] [{NODE}]: {'Pausing' if timeline.paused else 'Resuming'} play.")
+            elif command == "next" and timeline.paused:
+                self._step = True
+            elif command in ("faster", "slower"):
+                timeline.set_rate(timeline.rate * (1.1 if command == "faster" else 0.9))
+                self._log(f"[INFO] [{NODE}]: Set rate to {timeline.rate:g}")
+
+    def _tick(self, timeline: _Timeline, force: bool = False) -> None:
+        if self._clock is None or self.options.clock_hz is None:
+            return
+        now = time.monotonic()
+        if not force and now < self._next_tick:
+            return
+        period = 1.0 / self.options.clock_hz
+        self._next_tick = now + period if force else self._next_tick + period
+        if self._next_tick < now:  # fell behind (a slow send): keep the rate, not the backlog
+            self._next_tick = now + period
+        self._clock.send(self._clock_message(timeline.now()))
+
+
+def _clock_serializer() -> Callable[[int], bytes]:
+    """A function making /clock payloads (its types loaded now, not at the first tick)."""
+    from rosl.idl import registry
+
+    clock_type = registry.get_message_class("rosgraph_msgs/msg/Clock")
+    time_type = registry.get_message_class("builtin_interfaces/msg/Time")
+    store = registry.store()
+
+    def serialize(bag_ns: int) -> bytes:
+        sec, nanosec = divmod(bag_ns, NS)
+        return store.serialize(clock_type(clock=time_type(sec=sec, nanosec=nanosec)))
+
+    serialize(0)
+    return serialize

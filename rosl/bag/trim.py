@@ -1,0 +1,334 @@
+"""``rosl bag filter`` and ``convert``: a new rosbag2 folder holding a selection of a bag.
+
+Messages are copied untouched — payload bytes, log and publish times, sequence numbers — with
+their schemas and channel metadata (the ``offered_qos_profiles`` the recorder wrote), into one
+MCAP file plus ``metadata.yaml``. A selection is a set of topics, an exclusion pattern and a
+time window in seconds from the bag's first message; ``convert`` selects everything and only
+changes the chunk compression. :func:`scan` (the bag's channel table) is shared with the player.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, BinaryIO
+
+from rosl.bag import metadata
+from rosl.bag.errors import BagError
+from rosl.bag.reader import bag_files, has_summary, iter_bag
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from rosl.bag.reader import BagMessage
+
+NS = 1_000_000_000
+COMPRESSIONS = ("zstd", "lz4", "none")
+
+
+@dataclass(slots=True)
+class SourceChannel:
+    """One topic of a bag as its MCAP channel and schema records describe it."""
+
+    topic: str
+    type: str
+    schema_encoding: str
+    schema_data: bytes
+    message_encoding: str = "cdr"
+    metadata: dict[str, str] = field(default_factory=dict)
+    count: int = 0
+
+    def offered_qos(self) -> list[dict[str, Any]]:
+        """The ``offered_qos_profiles`` the recorder wrote in the channel's metadata."""
+        import yaml
+
+        text = self.metadata.get("offered_qos_profiles", "")
+        try:
+            profiles = yaml.safe_load(text) if text else []
+        except yaml.YAMLError:
+            return []
+        return [p for p in profiles if isinstance(p, dict)] if isinstance(profiles, list) else []
+
+
+@dataclass(slots=True)
+class Scan:
+    """What a bag holds, read from its summaries (streamed for unfinished files)."""
+
+    channels: dict[str, SourceChannel]
+    start_ns: int
+    end_ns: int
+    count: int
+    unfinished: list[Path]
+    info: dict[str, Any] | None
+    compression: str = ""
+
+
+@dataclass(slots=True)
+class CopyResult:
+    """What ``filter``/``convert`` wrote, and the warnings met on the way."""
+
+    folder: Path
+    written: dict[str, int]
+    total: int
+    compression: str
+    warnings: list[str] = field(default_factory=list)
+
+    def summary(self) -> str:
+        """One line: what went where."""
+        count = sum(self.written.values())
+        return (
+            f"wrote {count} of {self.total} messages on {len(self.written)} topics to "
+            f"'{self.folder}' ({self.compression or 'uncompressed'})"
+        )
+
+
+def unfinished_warning(path: Path) -> str:
+    """The one-line warning for a file whose recorder was killed."""
+    return (
+        f"warning: {path} is unfinished (its recorder stopped abruptly); using its complete "
+        f"records only — run `rosl bag reindex {path.parent}` to repair it"
+    )
+
+
+def scan(target: Path) -> Scan:
+    """The channels, time span and message count of a bag (folder or file).
+
+    Raises:
+        BagError: from :func:`rosl.bag.reader.bag_files`, or a file the MCAP reader rejects.
+    """
+    from mcap.exceptions import McapError
+
+    files, info = bag_files(target)
+    found = Scan({}, 0, 0, 0, [], info)
+    for path in files:
+        try:
+            with path.open("rb") as handle:
+                if not (has_summary(path) and _scan_summary(handle, found)):
+                    found.unfinished.append(path)
+                    handle.seek(0)
+                    _scan_records(handle, found)
+        except (McapError, OSError, ValueError) as err:
+            raise BagError(f"cannot read {path}: {err}") from None
+    return found
+
+
+def _channel(found: Scan, channel: Any, schema: Any) -> SourceChannel:
+    entry = found.channels.get(channel.topic)
+    if entry is None:
+        entry = found.channels[channel.topic] = SourceChannel(
+            channel.topic, schema.name if schema else "", schema.encoding if schema else "",
+            bytes(schema.data) if schema else b"", channel.message_encoding,
+            dict(channel.metadata),
+        )  # fmt: skip
+    return entry
+
+
+def _span(found: Scan, start: int, end: int, count: int) -> None:
+    if not count:
+        return
+    found.start_ns = start if not found.count else min(found.start_ns, start)
+    found.end_ns = max(found.end_ns, end)
+    found.count += count
+
+
+def _scan_summary(handle: BinaryIO, found: Scan) -> bool:
+    from mcap.reader import make_reader
+
+    summary = make_reader(handle).get_summary()
+    if summary is None or summary.statistics is None:
+        return False
+    stats = summary.statistics
+    for channel_id, channel in summary.channels.items():
+        entry = _channel(found, channel, summary.schemas.get(channel.schema_id))
+        entry.count += stats.channel_message_counts.get(channel_id, 0)
+    _span(found, stats.message_start_time, stats.message_end_time, stats.message_count)
+    if summary.chunk_indexes and not found.compression:
+        found.compression = summary.chunk_indexes[0].compression
+    return True
+
+
+def _scan_records(handle: BinaryIO, found: Scan) -> None:
+    from mcap.records import Channel, Message, Schema
+    from mcap.stream_reader import StreamReader
+
+    schemas: dict[int, Any] = {}
+    channels: dict[int, SourceChannel] = {}
+    start, end, count = 0, 0, 0
+    records = StreamReader(handle, skip_magic=False, emit_chunks=False).records
+    while True:
+        try:
+            record = next(records)
+        except StopIteration:
+            break
+        except Exception:
+            break  # the torn end of an unfinished file
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            channels[record.id] = _channel(found, record, schemas.get(record.schema_id))
+        elif isinstance(record, Message) and record.channel_id in channels:
+            channels[record.channel_id].count += 1
+            start = record.log_time if not count else min(start, record.log_time)
+            end = max(end, record.log_time)
+            count += 1
+    _span(found, start, end, count)
+
+
+def copy(
+    source: Path,
+    output: Path,
+    *,
+    topics: list[str] | None = None,
+    exclude: str | None = None,
+    start: float | None = None,
+    end: float | None = None,
+    compression: str | None = None,
+) -> CopyResult:
+    """Write the selected messages of ``source`` to a new rosbag2 folder ``output``.
+
+    Args:
+        source: a bag folder or MCAP file.
+        output: the folder to create (must not exist, or be empty).
+        topics: keep only these topics (all when None).
+        exclude: drop topics matching this regular expression.
+        start: drop messages earlier than this many seconds after the bag's first message.
+        end: drop messages later than this many seconds after the bag's first message.
+        compression: ``zstd``, ``lz4`` or ``none``; None keeps the source's.
+
+    Raises:
+        BagError: unreadable source, bad pattern or window, output not writable.
+    """
+    found = scan(source)
+    pattern = _pattern(exclude)
+    wanted = {
+        name
+        for name in found.channels
+        if (topics is None or name in topics) and not (pattern and pattern.search(name))
+    }
+    low = found.start_ns + round(start * NS) if start is not None else 0
+    high = found.start_ns + round(end * NS) if end is not None else 2**64
+    if high < low:
+        raise BagError(f"--end {end} is before --start {start}")
+    chosen = (found.compression or "none") if compression is None else compression
+    result = CopyResult(output, {}, found.count, "" if chosen == "none" else chosen)
+    result.warnings = [unfinished_warning(p) for p in found.unfinished]
+    result.warnings += [f"warning: topic {t} is not in {source}" for t in topics or () if
+                        t not in found.channels]  # fmt: skip
+    _prepare(source, output)
+    path = output / f"{output.name}_0.mcap"
+    file_info = metadata.FileInfo(path.name)
+    try:
+        with path.open("wb") as handle:
+            out = _Output(handle, chosen)
+            messages = iter_bag(source, wanted) if wanted else iter(())
+            for message in (m for m in messages if low <= m.log_time <= high):
+                out.add(found.channels[message.topic], message)
+                result.written[message.topic] = result.written.get(message.topic, 0) + 1
+                _extend(file_info, message.log_time)
+            out.writer.finish()
+            handle.flush()
+            os.fsync(handle.fileno())
+    except OSError as err:
+        raise BagError(f"cannot write {path}: {err.strerror}") from None
+    metadata.write(output, _topic_infos(found, result.written), [file_info], _custom(found))
+    return result
+
+
+class _Output:
+    """One MCAP file being written, with the schemas and channels registered so far."""
+
+    def __init__(self, handle: BinaryIO, compression: str) -> None:
+        from mcap.writer import CompressionType, Writer
+
+        kinds = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}
+        self.writer = Writer(
+            handle, compression=kinds.get(compression, CompressionType.NONE),
+            chunk_size=4 * 1024**2,
+        )  # fmt: skip
+        self.writer.start(profile="ros2", library="rosl bag filter")
+        self.schemas: dict[str, int] = {}
+        self.channels: dict[str, int] = {}
+
+    def add(self, channel: SourceChannel, message: BagMessage) -> None:
+        """Write one message unchanged (its channel registered the first time)."""
+        channel_id = self.channels.get(channel.topic)
+        if channel_id is None:
+            channel_id = self.channels[channel.topic] = self._register(channel)
+        self.writer.add_message(
+            channel_id, message.log_time, message.data, message.publish_time, message.sequence
+        )
+
+    def _register(self, channel: SourceChannel) -> int:
+        schema_id = self.schemas.get(channel.type)
+        if schema_id is None:
+            schema_id = self.schemas[channel.type] = (
+                self.writer.register_schema(
+                    channel.type, channel.schema_encoding, channel.schema_data
+                )
+                if channel.schema_encoding
+                else 0
+            )
+        channel_id: int = self.writer.register_channel(
+            channel.topic, channel.message_encoding, schema_id, dict(channel.metadata)
+        )
+        return channel_id
+
+
+def _pattern(exclude: str | None) -> re.Pattern[str] | None:
+    if exclude is None:
+        return None
+    try:
+        return re.compile(exclude)
+    except re.error as err:
+        raise BagError(f"--exclude '{exclude}' is not a regular expression: {err}") from None
+
+
+def _prepare(source: Path, output: Path) -> None:
+    if output.resolve() == source.resolve() or source.resolve().is_relative_to(output.resolve()):
+        raise BagError(f"the output folder '{output}' would overwrite the input '{source}'")
+    if output.exists() and (not output.is_dir() or any(output.iterdir())):
+        raise BagError(f"Output folder '{output}' already exists and is not empty")
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise BagError(f"cannot create '{output}': {err.strerror}") from None
+
+
+def _extend(info: metadata.FileInfo, log_time: int) -> None:
+    info.count += 1
+    info.start_ns = log_time if info.count == 1 else min(info.start_ns, log_time)
+    info.end_ns = max(info.end_ns, log_time)
+
+
+def _topic_infos(found: Scan, written: dict[str, int]) -> list[metadata.TopicInfo]:
+    previous = {
+        e["topic_metadata"]["name"]: e["topic_metadata"]
+        for e in (found.info or {}).get("topics_with_message_count", [])
+    }
+    infos = []
+    for name, count in written.items():
+        channel = found.channels[name]
+        old = previous.get(name, {})
+        qos = old.get("offered_qos_profiles")
+        info = metadata.TopicInfo(name, channel.type, count=count)
+        info.qos = list(qos) if isinstance(qos, list) else channel.offered_qos()
+        info.type_hash = str(old.get("type_description_hash") or "") or _hash(channel.type)
+        infos.append(info)
+    return infos
+
+
+def _hash(type_name: str) -> str:
+    from rosl.idl import registry
+    from rosl.idl.errors import InterfaceError
+
+    try:
+        registry.get_message_class(type_name)
+        return registry.store().type_hash(type_name)
+    except InterfaceError:
+        return ""
+
+
+def _custom(found: Scan) -> dict[str, str]:
+    custom = (found.info or {}).get("custom_data") or {}
+    return {str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {}
