@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "sim": ("rosl.cli.sim", "Simulate a 2D world: TurtleBot3 or Dolly, LiDAR, odometry, /clock"),
     "tf": ("rosl.cli.tf", "TF frames: the tree (view_frames) and transforms (tf2_echo)"),
     "topic": ("rosl.cli.topic", "Various topic related sub-commands"),
+    "viz": ("rosl.cli.viz", "Draw the world, paths, scans and frames from a bag or the bus"),
 }
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 

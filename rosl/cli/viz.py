@@ -1,0 +1,56 @@
+"""``rosl viz [BAG] -o FILE``: the world, paths, last scan and frames as a picture (RViz's job)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from rosl.cli import render
+from rosl.cli.options import domain_option
+
+
+@click.command("viz")
+@click.argument("bag", required=False, type=click.Path(path_type=Path))
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="Picture to write: .png or .svg (default: BAG.png, or viz.png when live)",
+)
+@click.option(
+    "--fixed-frame",
+    "-f",
+    default="odom",
+    show_default=True,
+    help="The frame everything is drawn in (RViz's Fixed Frame)",
+)
+@click.option(
+    "--duration",
+    type=float,
+    default=2.0,
+    show_default=True,
+    help="Live: seconds to listen before drawing",
+)
+@domain_option
+def command(
+    bag: Path | None, output: Path | None, fixed_frame: str, duration: float, domain_id: int | None
+) -> None:
+    """Draw a bag (`rosl viz run1 -o path.png`) or the live system (`rosl viz -o now.png`)."""
+    from rosl.introspection import viz
+
+    if bag is not None:
+        if not bag.exists():
+            raise click.BadParameter(f"no bag at {bag}", param_hint="BAG")
+        target = output or Path(f"{str(bag).rstrip('/')}.png")
+        builder = viz.from_bag(bag, fixed_frame)
+        title = bag.name
+    else:
+        from rosl.introspection.session import Session
+
+        target = output or Path("viz.png")
+        with Session(domain_id) as session:
+            builder = viz.live(session, fixed_frame, duration)
+        title = "live"
+    render.lines([f"wrote {viz.draw(builder, target, title)}"])
