@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
 from rosl.idl.registry import get_message_class
+from rosl.sim import encode
 from rosl.sim import lidar as lidar_cast
 from rosl.sim.worldfile import Circle, Polygon, Segment
 
@@ -282,3 +283,73 @@ def urdf(model: RobotModel) -> str:
         )
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
+
+
+# --- the same messages as CDR bytes (the sim's hot path; see encode.py) ------------------------
+
+_COVARIANCE = tuple(POSE_COVARIANCE[k // 7] if k % 7 == 0 else 0.0 for k in range(36))
+
+
+def clock_bytes(now_ns: int) -> bytes:
+    """rosgraph_msgs/Clock as CDR."""
+    return encode.clock(now_ns)
+
+
+def odometry_bytes(sim_robot: SimRobot, now_ns: int) -> bytes:
+    """nav_msgs/Odometry as CDR (same as :func:`odometry`)."""
+    model = sim_robot.robot.spec.model
+    (x, y, yaw), (forward, turn) = sim_robot.robot.odometry()
+    return encode.odometry(
+        now_ns, model.odom_frame.encode(), model.base_frame.encode(),
+        (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), _COVARIANCE,
+        (forward, 0.0, 0.0, 0.0, 0.0, turn),
+    )  # fmt: skip
+
+
+Transform = tuple[bytes, bytes, tuple[float, ...]]
+
+
+def odom_transform(sim_robot: SimRobot) -> Transform:
+    """``odom -> base_footprint`` for :func:`tf_bytes` (same as :func:`odom_tf`)."""
+    model = sim_robot.robot.spec.model
+    (x, y, yaw), _ = sim_robot.robot.odometry()
+    return (model.odom_frame.encode(), model.base_frame.encode(),
+            (x, y, 0.0, *quaternion(0.0, 0.0, yaw)))  # fmt: skip
+
+
+def wheel_transforms(sim_robot: SimRobot) -> list[Transform]:
+    """The wheel links turned by their joints for :func:`tf_bytes` (same as :func:`wheel_tf`)."""
+    model = sim_robot.robot.spec.model
+    angles = dict(zip(model.joints, sim_robot.robot.wheels, strict=False))
+    transforms = []
+    for frame in model.frames:
+        if frame.joint is None:
+            continue
+        rotation = quaternion(*frame.rpy)
+        spin = angles.get(frame.joint, 0.0)
+        if spin:
+            rotation = multiply(rotation, (0.0, 0.0, math.sin(spin / 2), math.cos(spin / 2)))
+        transforms.append((frame.parent.encode(), frame.name.encode(), (*frame.xyz, *rotation)))
+    return transforms
+
+
+def tf_bytes(transforms: list[Transform], now_ns: int) -> bytes:
+    """tf2_msgs/TFMessage of the given transforms as CDR."""
+    return encode.tf_message(now_ns, transforms)
+
+
+def joint_states_bytes(sim_robot: SimRobot, now_ns: int) -> bytes:
+    """sensor_msgs/JointState as CDR (same as :func:`joint_states`)."""
+    robot = sim_robot.robot
+    joints = robot.spec.model.joints
+    return encode.joint_state(
+        now_ns, [j.encode() for j in joints], robot.wheels[: len(joints)],
+        robot.wheel_rates[: len(joints)],
+    )  # fmt: skip
+
+
+def laser_scan_bytes(lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:
+    """sensor_msgs/LaserScan as CDR (same as :func:`laser_scan`)."""
+    fields = (lidar.angle_min, lidar.angle_max, lidar_cast.increment(lidar), 0.0,
+              1.0 / lidar.rate, lidar.range_min, lidar.range_max)  # fmt: skip
+    return encode.laser_scan(now_ns, lidar.frame_id.encode(), fields, ranges)

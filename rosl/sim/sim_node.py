@@ -245,11 +245,16 @@ class SimNode:
 
         return take
 
+    def _logger(self) -> Any:
+        """The node's logger, its clock moved to the current sim time (for /rosout stamps)."""
+        self.node.get_clock().set_sim_now(self.sim.now_ns)
+        return self.node.get_logger()
+
     def _warn(self, text: str) -> None:
         kind = text.split("(")[0]
         self._warned[kind] = self._warned.get(kind, 0) + 1
         if self._warned[kind] == 1:  # once per kind; the summary counts the rest
-            self.node.get_logger().warn(f"{text}; further ones are counted, not shown")
+            self._logger().warn(f"{text}; further ones are counted, not shown")
 
     # --- publishing --------------------------------------------------------------------------
 
@@ -265,8 +270,8 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
-        self.node.get_clock().set_sim_now(now)
         sampled = False
+        transforms: list[build.Transform] = []
         for topics in self.robots:
             sim_robot = topics.sim_robot
             if sim_robot.odom.due(now):
@@ -275,24 +280,23 @@ class SimNode:
                     sim.sample()
                     sampled = True
                 if topics.odom.wanted():
-                    topics.odom.send(build.odometry(sim_robot, now))
-                if self.tf.wanted():
-                    self.tf.send(build.odom_tf(sim_robot, now))
+                    topics.odom.send(build.odometry_bytes(sim_robot, now))
+                transforms.append(build.odom_transform(sim_robot))
             if sim_robot.joints is not None and sim_robot.joints.due(now):
                 sim_robot.joints.fire(now)
                 if topics.joints is not None and topics.joints.wanted():
-                    topics.joints.send(build.joint_states(sim_robot, now))
-                wheels = build.wheel_tf(sim_robot, now) if self.tf.wanted() else None
-                if wheels is not None:
-                    self.tf.send(wheels)
+                    topics.joints.send(build.joint_states_bytes(sim_robot, now))
+                transforms += build.wheel_transforms(sim_robot)
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
                 if schedule.due(now):
                     index = schedule.fire(now)
                     if topic.wanted() or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if topic.wanted():
-                            topic.send(build.laser_scan(lidar, ranges, now))
-        self.clock.send(build.clock(now))
+                            topic.send(build.laser_scan_bytes(lidar, ranges, now))
+        if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
+            self.tf.send(build.tf_bytes(transforms, now))
+        self.clock.send(build.clock_bytes(now))
 
     # --- running -----------------------------------------------------------------------------
 
@@ -309,7 +313,7 @@ class SimNode:
                 participant,
                 timeout=options.lockstep_timeout,
                 on_stall=options.on_stall,
-                log=lambda line: self.node.get_logger().warn(line),
+                log=lambda line: self._logger().warn(line),
             )
             for publisher in [self.clock, self.tf] + [
                 t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t

@@ -1,0 +1,135 @@
+"""Simulator speed: real-time factor headless, and in lock-step with a controller process.
+
+    .venv/bin/python bench/sim_rtf.py [--seconds 60]
+
+Rows (median of 3):
+  core        physics + scans + odometry bookkeeping, no messages (the ceiling)
+  node        the sim node publishing every topic to the bus (as if all were subscribed)
+  node-720    the same with a 10 Hz x 720-ray LiDAR
+  lock-step   `rosl sim --fast` with the obstacle-avoidance node in another process answering
+              every scan over the bus (the demo's set-up, recording off)
+Each row prints its real-time factor (sim seconds per wall second) and its ratio to the core
+measured in this run. Targets (issue 7): node >= 200x, node-720 >= 100x, lock-step >= 30x;
+Gazebo runs these worlds at 1x, ir-sim ~2x with a per-step LiDAR.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _harness import BENCH_DOMAIN
+
+NS = 1_000_000_000
+
+
+def world(rays: int = 360, rate: float = 5.0):
+    from rosl.sim.worldfile import load_world, resolve_world
+
+    loaded = load_world(resolve_world("turtlebot3_world"))
+    if rays == 360 and rate == 5.0:
+        return loaded
+    robots = []
+    for spec in loaded.robots:
+        lidars = tuple(dataclasses.replace(lidar, samples=rays, rate=rate,
+                                           angle_max=lidar.angle_min + 6.28)
+                       for lidar in spec.model.lidars)  # fmt: skip
+        model = dataclasses.replace(spec.model, lidars=lidars)
+        robots.append(dataclasses.replace(spec, model=model))
+    return dataclasses.replace(loaded, robots=tuple(robots))
+
+
+def core(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
+    from rosl.sim.simulation import Simulation
+
+    sim = Simulation(world(rays, rate))
+    robot = sim.robots[0]
+    robot.robot.command(0.1, 0.2)
+    end = round(seconds * NS)
+    started = time.perf_counter()
+    while sim.now_ns < end:
+        sim.step()
+        if robot.odom.due(sim.now_ns):
+            robot.odom.fire(sim.now_ns)
+            sim.sample()
+        for lidar, schedule in robot.lidars:
+            if schedule.due(sim.now_ns):
+                sim.scan(robot, lidar, schedule.fire(sim.now_ns))
+    return seconds / (time.perf_counter() - started)
+
+
+def node(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
+    import rosl
+    from rosl.sim.sim_node import SimNode, SimOptions
+    from rosl.sim.simulation import Simulation
+
+    rosl.init([], domain_id=BENCH_DOMAIN)
+    sim_node = rosl.Node("sim")
+    try:
+        options = SimOptions(real_time_factor=1e9, duration=seconds, headless=True)
+        runner = SimNode(Simulation(world(rays, rate)), sim_node, options, publish_all=True)
+        report = runner.run()
+        return report.sim_seconds / report.wall_seconds
+    finally:
+        sim_node.destroy_node()
+        rosl.try_shutdown()
+
+
+def lockstep(seconds: float) -> float:
+    env = {**os.environ, "ROSL_DOMAIN_ID": str(BENCH_DOMAIN)}
+    rosl_cmd = [sys.executable, "-m", "rosl"]
+    controller = subprocess.Popen(
+        [*rosl_cmd, "run", "my_package", "obstacle_avoidance", "--ros-args",
+         "-r", "laser_scan:=/scan", "-p", "use_sim_time:=true", "-p", "distance_threshold:=0.5",
+         "-p", "field_of_view:=1.2", "--log-level", "warn"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    try:
+        out = subprocess.run(
+            [*rosl_cmd, "sim", "turtlebot3_world", "--fast", "--headless",
+             "--duration", str(seconds), "--wait-for", "ObstacleAvoidance"],
+            env=env, capture_output=True, text=True, timeout=600, check=True,
+        ).stdout  # fmt: skip
+    finally:
+        controller.terminate()
+        try:
+            controller.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            controller.kill()
+            controller.wait()
+    first = out.splitlines()[0]  # "simulated S s of W in T s (F x real time, lock-step)"
+    words = first.split()
+    return float(words[1]) / float(words[6])
+
+
+def median(run, *args: object, repeats: int = 3) -> float:
+    return statistics.median(run(*args) for _ in range(repeats))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seconds", type=float, default=60.0)
+    args = parser.parse_args()
+    seconds = args.seconds
+    base = median(core, seconds)
+    rows = [
+        ("core (5 Hz x 360, no messages)", base, None),
+        ("node (5 Hz x 360, every topic sent)", median(node, seconds), 200),
+        ("node-720 (10 Hz x 720, every topic sent)", median(node, seconds, 720, 10.0), 100),
+        ("lock-step (obstacle avoidance in another process)", median(lockstep, seconds), 30),
+    ]
+    print(f"{'scenario':52} {'RTF':>8} {'vs core':>8} {'target':>8}")
+    for name, rtf, target in rows:
+        aim = f">={target}x" if target else "-"
+        print(f"{name:52} {rtf:7.1f}x {rtf / base:8.2f} {aim:>8}")
+
+
+if __name__ == "__main__":
+    main()
