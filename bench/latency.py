@@ -54,10 +54,9 @@ def raw_ping(rounds: int, size: int) -> list[float]:
 
 
 def rosl_pong() -> None:
-    from std_msgs.msg import UInt8MultiArray
-
     import rosl
 
+    UInt8MultiArray = rosl.get_interface("std_msgs/msg/UInt8MultiArray")  # noqa: N806
     rosl.init([], domain_id=BENCH_DOMAIN)
     node = rosl.Node("pong")
     pub = node.create_publisher(UInt8MultiArray, "/bench_pong", 10)
@@ -68,10 +67,9 @@ def rosl_pong() -> None:
 
 
 def rosl_ping(rounds: int, size: int) -> list[float]:
-    from std_msgs.msg import UInt8MultiArray
-
     import rosl
 
+    UInt8MultiArray = rosl.get_interface("std_msgs/msg/UInt8MultiArray")  # noqa: N806
     rosl.init([], domain_id=BENCH_DOMAIN)
     node = rosl.Node("ping")
     pub = node.create_publisher(UInt8MultiArray, "/bench_ping", 10)

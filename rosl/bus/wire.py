@@ -28,6 +28,8 @@ if TYPE_CHECKING:
 _SMALL = 2048  # below this, joining header and payload beats a scatter send
 _unpack_header = HEADER.unpack_from
 _MAGIC = hdr.MAGIC
+_ADDRESSED = int(Flags.ADDRESSED)  # plain ints: enum operators are slow per datagram
+_DATA = int(Kind.DATA)
 _VERSION = hdr.VERSION
 
 
@@ -198,13 +200,13 @@ class Reader:
                     continue
                 payload = whole
             address = None
-            if flags & Flags.ADDRESSED:
+            if flags & _ADDRESSED:
                 if len(payload) < ADDRESS_SIZE:
                     self.reassembler.malformed += 1
                     continue
                 address = ADDRESS.unpack_from(payload)
                 payload = memoryview(payload)[ADDRESS_SIZE:]
-            if kind == Kind.DATA:
+            if kind == _DATA:
                 self._count(sender, endpoint, topic, seq, now)
             out.append(
                 Delivery(

@@ -25,6 +25,9 @@ if TYPE_CHECKING:
     from rosl.node.qos import QoSProfile
 
 
+_REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster than enums
+
+
 def _wants_info(callback: Callable[..., Any]) -> bool:
     try:
         params = [
@@ -91,7 +94,7 @@ class Subscription:
         """Decode one delivery for this topic and call back."""
         if self.destroyed:
             return
-        if delivery.kind == Kind.REPLAY:
+        if delivery.kind == _REPLAY:
             address = delivery.address
             if address is None or address[0] != self._sender or address[1] != self.endpoint:
                 return
@@ -99,7 +102,7 @@ class Subscription:
             if key in self._replayed:
                 return
             self._replayed.append(key)
-        elif delivery.kind != Kind.DATA:
+        elif delivery.kind != _DATA:
             return
         elif self.qos_profile.keeps_history:
             self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
