@@ -34,7 +34,7 @@ def command() -> None:
     "--output",
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
-    help="Write FILE (.dot/.gv, .txt; .svg/.png/.pdf need Graphviz's dot)",
+    help="Write FILE: .dot/.gv, .txt, or a picture .svg/.png/.pdf",
 )
 @domain_option
 def frames(wait_time: float, as_dot: bool, output: Path | None, domain_id: int | None) -> None:

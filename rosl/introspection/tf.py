@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
 TOPICS = ("/tf", "/tf_static")
 HISTORY = 100  # receive times kept per edge, for the rate
+DRAWN = ("svg", "png", "pdf")  # pictures rosl can draw itself
 Vector = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]  # x, y, z, w
 
@@ -395,6 +396,8 @@ def output_format(path: Path) -> str:
     suffix = path.suffix.lower().lstrip(".")
     if suffix in ("dot", "gv", "txt"):
         return "text" if suffix == "txt" else "dot"
+    if suffix in DRAWN:  # Graphviz when it is there, else rosl's own drawing
+        return suffix
     if suffix in GRAPHVIZ_FORMATS:
         require_graphviz(suffix, "-o FILE.dot, or the text tree")
         return suffix
@@ -405,8 +408,19 @@ def output_format(path: Path) -> str:
 
 
 def export(buffer: TfBuffer, path: Path) -> None:
-    """Write the tree to ``path`` (text, DOT, or svg/png/pdf through Graphviz)."""
+    """Write the tree to ``path``: text, DOT, or a picture.
+
+    Pictures (svg/png/pdf) come from Graphviz when it is installed, else from
+    :mod:`rosl.introspection.tf_picture`.
+    """
+    import shutil
+
     from rosl.introspection.graph_view import write
 
     fmt = output_format(path)
+    if fmt in DRAWN and shutil.which("dot") is None:
+        from rosl.introspection import tf_picture
+
+        tf_picture.write(buffer, path)
+        return
     write(path, frames_text(buffer) if fmt == "text" else frames_dot(buffer), fmt)

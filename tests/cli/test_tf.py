@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
@@ -12,7 +14,6 @@ from tests.graph.support import Watched
 
 if TYPE_CHECKING:
     from collections.abc import Callable
-    from pathlib import Path
 
     from tests.conftest import Processes
 
@@ -143,12 +144,21 @@ def test_no_tf_data_is_one_clear_line_and_exit_1(processes) -> None:
     assert result.out == ""
 
 
-def test_frames_to_pdf_without_graphviz_is_one_line_before_listening(
-    rosl: Callable[..., Result], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+def test_frames_to_pdf_without_graphviz_is_drawn_by_rosl(
+    robot, processes, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    monkeypatch.setenv("PATH", f"{tmp_path / 'empty'}:{Path(sys.executable).parent}")
     target = tmp_path / "frames.pdf"
-    assert_user_error(rosl("tf", "frames", "-o", str(target)), "graphviz's 'dot' is not installed")
+    result = run(processes, "tf", "frames", "-t", "0.5", "-o", str(target))
+    assert result.code == 0, result.err
+    assert target.read_bytes().startswith(b"%PDF")
+
+
+def test_frames_to_an_unknown_picture_type_is_one_line_before_listening(
+    rosl: Callable[..., Result], tmp_path: Path
+) -> None:
+    target = tmp_path / "frames.xyz"
+    assert_user_error(rosl("tf", "frames", "-o", str(target)), "unknown file type")
     assert not target.exists()
 
 
