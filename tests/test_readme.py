@@ -15,6 +15,7 @@ def readme_commands() -> list[str]:
 def test_readme_opens_with_an_install_and_a_test_command():
     demo, tests = readme_commands()
     assert "pip install" in demo
+    assert demo.endswith("rosl launch rosl_sim demo.launch.py")
     assert "pip install" in tests
     assert "pytest" in tests
 

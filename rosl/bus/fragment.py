@@ -107,6 +107,8 @@ class Reassembler:
     def _finish(self, key: tuple[int, int, int, int]) -> None:
         partial = self._partial.pop(key)
         self._pending -= len(partial.buffer)
+        if self._latest.get(key[:3]) == key:  # nothing of that stream is pending any more
+            del self._latest[key[:3]]
 
     def _drop(self, key: tuple[int, int, int, int]) -> None:
         self._finish(key)

@@ -143,7 +143,10 @@ def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
         sock.setsockopt(socket.IPPROTO_IP, IP_MULTICAST_ALL, 0)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, RCVBUF_WANTED)
-        sock.bind(("", addressing.port))
+        # bound to the group itself: with SO_REUSEPORT, a socket bound to 0.0.0.0 can be
+        # handed another group's datagrams arriving on a real interface (reuseport picks one
+        # socket per flow); the group address makes the kernel filter by destination
+        sock.bind((group, addressing.port))
         membership = struct.pack(
             "4s4s", socket.inet_aton(group), socket.inet_aton(addressing.interface)
         )

@@ -108,7 +108,7 @@ class Writer:
         flags = self.flags
         if address is not None:
             payload = ADDRESS.pack(*address) + bytes(payload)
-            flags = Flags.ADDRESSED
+            flags |= _ADDRESSED
         total = len(payload)
         when = time.time_ns() if stamp is None else stamp
         kind_value = self.kind if kind is None else kind

@@ -247,7 +247,7 @@ class Discovery:
         try:
             message = json.loads(bytes(delivery.payload))
             op = message["op"]
-        except (ValueError, KeyError, TypeError):
+        except (ValueError, KeyError, TypeError, RecursionError):
             self.malformed += 1
             return
         if delivery.sender == self.sender:
@@ -261,8 +261,8 @@ class Discovery:
                 self._on_query(message, delivery.sender)
             elif op in self.handlers:
                 self.handlers[op](message)
-        except (ValueError, KeyError, TypeError, AttributeError):
-            self.malformed += 1
+        except (ValueError, KeyError, TypeError, AttributeError, OverflowError, RecursionError):
+            self.malformed += 1  # one bad datagram must never stop discovery
 
     def _on_hello(self, message: dict[str, Any], sender: int) -> None:
         record = from_json(message["process"], time.monotonic())

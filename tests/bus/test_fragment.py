@@ -28,12 +28,12 @@ def header(
     endpoint: int = 3,
     kind: int = Kind.DATA,
 ) -> Header:
-    return Header(MAGIC, VERSION, kind, 0, count, sender, seq, 0x7077, 0x7E, index, endpoint, total, 0)
+    return Header(
+        MAGIC, VERSION, kind, 0, count, sender, seq, 0x7077, 0x7E, index, endpoint, total, 0
+    )
 
 
-def fragments(
-    payload: bytes, chunk: int = CHUNK, **key: int
-) -> list[tuple[Header, memoryview]]:
+def fragments(payload: bytes, chunk: int = CHUNK, **key: int) -> list[tuple[Header, memoryview]]:
     """The (header, payload view) pairs a Writer would send for ``payload``."""
     return [
         (header(total=len(payload), count=count, index=index, **key), view)

@@ -254,9 +254,7 @@ def assert_no_traceback(name: str, err: list[str]) -> None:
 
 
 @pytest.mark.slow
-def test_nodes_survive_thousands_of_garbage_datagrams(
-    processes: Processes, domain_id: int
-) -> None:
+def test_nodes_survive_thousands_of_garbage_datagrams(processes: Processes, domain_id: int) -> None:
     talker = Node(processes, TALKER, TALKER_NAME)
     listener = Node(processes, LISTENER, LISTENER_NAME)
     talker.wait_up()
@@ -315,7 +313,8 @@ def test_discovery_survives_one_poisonous_datagram(
     talker = Node(processes, TALKER, TALKER_NAME)
     talker.wait_up()
     hellos, messages = capture_real_datagrams(domain_id)
-    assert hellos and messages
+    assert hellos
+    assert messages
     sender = unpack(hellos[0]).sender  # type: ignore[union-attr]
     payload = POISON[case]
     if payload is None:

@@ -6,6 +6,7 @@ otherwise. Everything they send stays inside namespaces the test creates and del
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -31,9 +32,7 @@ TOPIC = "/netns_chatter"
 
 
 def ip(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        ["ip", *args], capture_output=True, text=True, timeout=15, check=check
-    )
+    return subprocess.run(["ip", *args], capture_output=True, text=True, timeout=15, check=check)
 
 
 class Namespaces:
@@ -167,6 +166,97 @@ def test_interface_given_by_address_works_too(netns: Namespaces, domain_id: int)
     finally:
         stop(listener)
         stop(talker)
+
+
+SOCKETS_RECEIVER = r"""
+import json, select, sys, time
+from rosl.bus.multicast import Addressing
+from rosl.bus.transport import MulticastTransport
+from rosl.bus.wire import Reader
+
+domain, address, expected = int(sys.argv[1]), sys.argv[2], int(sys.argv[3])
+channels = [int(c) for c in sys.argv[4].split(",")]
+transport = MulticastTransport(Addressing(domain, address, 1))
+sockets = {c: transport.open(c) for c in channels}
+reader = Reader()
+reader.want_all = True
+counts = {c: 0 for c in channels}
+print("ready", flush=True)
+deadline = time.monotonic() + 15
+heard = None
+while time.monotonic() < deadline and sum(counts.values()) < expected:
+    if heard is not None and time.monotonic() - heard > 2.0:
+        break
+    ready, _, _ = select.select(list(sockets.values()), [], [], 0.1)
+    for channel, sock in sockets.items():
+        if sock in ready:
+            heard = time.monotonic()
+            got = []
+            while reader.drain(sock, got):
+                pass
+            counts[channel] += len(got)
+print(json.dumps(counts), flush=True)
+transport.close()
+"""
+
+SOCKETS_SENDER = r"""
+import sys, time
+from rosl.bus.multicast import Addressing
+from rosl.bus.transport import MulticastTransport
+from rosl.bus.wire import Writer
+
+domain, address, channel, flows, each = (int(sys.argv[1]), sys.argv[2], int(sys.argv[3]),
+                                         int(sys.argv[4]), int(sys.argv[5]))
+# every transport has its own sending socket, so its own source port: a flow of its own
+writers = [
+    Writer(MulticastTransport(Addressing(domain, address, 1)), 1000 + n, 1, "/flow", "a/b/C",
+           channel=channel)
+    for n in range(flows)
+]
+for _ in range(each):
+    for writer in writers:
+        writer.send(b"payload")
+    time.sleep(0.005)
+print("sent", flush=True)
+"""
+
+
+def test_each_channel_socket_gets_only_its_group_across_a_veth(
+    netns: Namespaces, domain_id: int
+) -> None:
+    """A datagram for one group must reach that group's socket, and no other channel's.
+
+    rosl binds every channel socket to 0.0.0.0:port with SO_REUSEPORT and tells them apart by
+    group membership (IP_MULTICAST_ALL=0). Over loopback that holds; datagrams arriving on a
+    real interface must be delivered by membership too, whatever their source port.
+    """
+    a, _, b, _ = veth_pair(netns)
+    subnet = int(netns.suffix[:2], 16) % 250 + 1
+    target, others = 21, [0, 3, 14, 18, 23, 26, 54]  # like a node: discovery + 7 channels
+    flows, each = 16, 20
+    receiver = netns.run(
+        b,
+        python(SOCKETS_RECEIVER, str(domain_id), f"10.77.{subnet}.2", str(flows * each),
+               ",".join(map(str, [*others, target]))),
+    )  # fmt: skip
+    out, err = Lines(receiver.stdout), Lines(receiver.stderr)
+    assert out.wait_line("ready", 20.0), err.rest(1.0)
+    sender = netns.run(
+        a,
+        python(SOCKETS_SENDER, str(domain_id), f"10.77.{subnet}.1", str(target), str(flows),
+               str(each)),
+    )  # fmt: skip
+    sent = Lines(sender.stdout)
+    assert sent.wait_line("sent", 20.0), Lines(sender.stderr).rest(1.0)
+    line = out.wait_line("{", 25.0)
+    assert line is not None, err.rest(1.0)
+    counts = {int(k): v for k, v in json.loads(line).items()}
+    misdelivered = {c: n for c, n in counts.items() if c != target and n}
+    assert not misdelivered, (
+        f"datagrams for group .{target} were delivered to other channels' sockets "
+        f"{misdelivered} (and {counts[target]} to the right one)"
+    )
+    assert counts[target] == flows * each
 
 
 # --- no usable multicast: one clear line ------------------------------------------------------

@@ -5,7 +5,6 @@ from __future__ import annotations
 import hashlib
 import os
 import random
-import signal
 import socket
 import struct
 import time
@@ -145,6 +144,27 @@ def test_payload_types_bytearray_and_memoryview(bus: Bus) -> None:
     assert [bytes(d.payload) for d in got] == [bytes(small), bytes(big)]
 
 
+def test_writer_flags_are_carried_on_every_fragment(bus: Bus) -> None:
+    bus.writer.flags = Flags.LOCKSTEP
+    bus.writer.send(b"tick")
+    bus.writer.send(payload_of(CHUNK * 3))
+    got = bus.collector.wait_count(2, timeout=5.0)
+    assert [d.flags for d in got] == [Flags.LOCKSTEP, Flags.LOCKSTEP]
+    assert bytes(got[1].payload) == payload_of(CHUNK * 3)
+
+
+def test_last_seq_follows_the_writers_own_numbers(bus: Bus) -> None:
+    assert bus.writer.last_seq == 0
+    bus.writer.send(b"a")
+    bus.writer.send(b"b")
+    assert bus.writer.last_seq == 2
+    bus.writer.send(b"replayed", seq=1, kind=Kind.REPLAY, address=(1, 2, 3))
+    assert bus.writer.last_seq == 2  # a reused number is not the stream's latest
+    got = bus.collector.wait_count(3)
+    assert [d.seq for d in got] == [1, 2, 1]
+    assert got[2].flags & Flags.ADDRESSED
+
+
 # --- loss counting ----------------------------------------------------------------------------
 
 
@@ -230,7 +250,9 @@ def test_want_all_takes_every_topic(bus: Bus) -> None:
 def test_a_reader_only_hears_the_channels_it_joined(bus: Bus) -> None:
     channel = bus.writer.channel
     name = next(
-        f"/bus_test/x{i}" for i in range(1000) if channel_of(topic_hash(f"/bus_test/x{i}")) != channel
+        f"/bus_test/x{i}"
+        for i in range(1000)
+        if channel_of(topic_hash(f"/bus_test/x{i}")) != channel
     )
     bus.reader.want_all = True
     Writer(bus.tx, SENDER, 9, name, TYPE).send(b"elsewhere")
@@ -271,7 +293,9 @@ def test_single_datagram_with_a_lying_total_is_malformed(bus: Bus) -> None:
 # --- addressed datagrams ----------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("size", [0, 100, CHUNK, 3 * CHUNK + 5], ids=["0", "100", "chunk", "3chunk+5"])
+@pytest.mark.parametrize(
+    "size", [0, 100, CHUNK, 3 * CHUNK + 5], ids=["0", "100", "chunk", "3chunk+5"]
+)
 def test_addressed_messages_come_back_with_the_address_stripped(bus: Bus, size: int) -> None:
     payload = payload_of(size, seed=size)
     address = (0xFEED_FACE_CAFE_BEEF, 513, 2**32 - 1)
@@ -331,7 +355,9 @@ def test_a_stale_partial_message_is_dropped_after_max_age(bus: Bus) -> None:
     bus.writer.send(b"later traffic")
     assert len(bus.collector.wait_count(2)) == 2
     bus.collector.wait_for(lambda _: bus.reader.reassembler.pending == 0, timeout=1.0)
-    assert bus.reader.reassembler.pending == 0, "stale partial never expired (Reader never calls expire)"
+    assert bus.reader.reassembler.pending == 0, (
+        "stale partial never expired (Reader never calls expire)"
+    )
     assert bus.reader.reassembler.incomplete == 1
 
 
@@ -351,7 +377,8 @@ def test_two_domains_do_not_see_each_other(domain_id: int) -> None:
             time.sleep(0.2)  # give a leak time to show up
             assert [bytes(d.payload) for d in a.collector.snapshot()] == [b"from A"]
             assert [bytes(d.payload) for d in b.collector.snapshot()] == [b"from B"]
-            assert got_a and got_b
+            assert got_a
+            assert got_b
             assert a.reader.foreign == b.reader.foreign == 0
         finally:
             a.close()
@@ -373,9 +400,10 @@ def test_sender_socket_keeps_traffic_on_loopback(domain_id: int) -> None:
     try:
         sock = t._sender
         assert sock.getsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL) == 0
-        assert socket.inet_ntoa(
-            sock.getsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, 4)
-        ) == "127.0.0.1"
+        assert (
+            socket.inet_ntoa(sock.getsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, 4))
+            == "127.0.0.1"
+        )
     finally:
         t.close()
 
@@ -441,8 +469,10 @@ def test_16_mib_crosses_to_another_process_three_times(
             sent.append(f"msg {seq} {size} {hashlib.sha256(payload).hexdigest()}")
             # wait for the receiver's answer (or its final stats line if a fragment was lost)
             out.wait_for(
-                lambda lines, n=n: sum(x.startswith("msg ") for x in lines) >= n
-                or any(x.startswith("stats") for x in lines),
+                lambda lines, n=n: (
+                    sum(x.startswith("msg ") for x in lines) >= n
+                    or any(x.startswith("stats") for x in lines)
+                ),
                 30.0,
             )
         assert transport.send_errors == 0
@@ -550,7 +580,9 @@ def test_interface_by_name_or_address(clean_env: pytest.MonkeyPatch) -> None:
 # --- sockets ----------------------------------------------------------------------------------
 
 
-def test_opening_every_receiver_never_raises(domain_id: int, capsys: pytest.CaptureFixture[str]) -> None:
+def test_opening_every_receiver_never_raises(
+    domain_id: int, capsys: pytest.CaptureFixture[str]
+) -> None:
     t = MulticastTransport(Addressing(domain_id))
     try:
         socks = [t.open(c) for c in range(CHANNELS + 1)]
@@ -623,4 +655,3 @@ def test_closing_a_receiving_transport_stops_delivery(domain_id: int) -> None:
     b.rx.close()
     b.writer.send(b"nobody")  # must not raise with no receivers left
     b.tx.close()
-    assert signal.SIGINT  # keep the signal import used
