@@ -67,7 +67,8 @@ def core(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
 
 def node(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
     import rosl
-    from rosl.sim.sim_node import SimNode, SimOptions
+    from rosl.sim.options import SimOptions
+    from rosl.sim.sim_node import SimNode
     from rosl.sim.simulation import Simulation
 
     rosl.init([], domain_id=BENCH_DOMAIN)

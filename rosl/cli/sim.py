@@ -74,8 +74,8 @@ from rosl.cli.options import domain_option
 @domain_option
 def command(world: str, **options: Any) -> None:
     """Simulate a world: `rosl sim turtlebot3_world` (shipped worlds by name, or a file)."""
+    from rosl.sim.options import SimOptions
     from rosl.sim.runner import simulate
-    from rosl.sim.sim_node import SimOptions
 
     record = options["record"]
     if record == "":

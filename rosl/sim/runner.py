@@ -10,7 +10,8 @@ from rosl.sim.errors import SimError
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from rosl.sim.sim_node import SimOptions, SimReport
+    from rosl.sim.options import SimOptions
+    from rosl.sim.report import SimReport
 
 
 def check_options(options: SimOptions) -> None:
@@ -73,7 +74,7 @@ def run_sim(argv: list[str]) -> int:
     """``sim WORLD [options] [--ros-args ...]``: the rosl_sim package's executable."""
     from rosl.errors import RoslError
     from rosl.node.ros_args import split_ros_args
-    from rosl.sim.sim_node import parse_arguments
+    from rosl.sim.options import parse_arguments
 
     _, user = split_ros_args(argv)
     world, options, seed = parse_arguments(user)
@@ -84,3 +85,8 @@ def run_sim(argv: list[str]) -> int:
         return 1
     print("\n".join(report.lines()), flush=True)
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``rosl run rosl_sim sim WORLD ...`` (and launch files' Node actions)."""
+    return run_sim(sys.argv[1:] if argv is None else argv)

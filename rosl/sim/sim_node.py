@@ -16,102 +16,27 @@ With ``record``, an in-process recorder writes the bus to MCAP with sim-time log
 
 from __future__ import annotations
 
-import math
 import sys
 import time
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import SUBSCRIPTION
 from rosl.sim import messages as build
+from rosl.sim.report import RobotReport, SimReport
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from pathlib import Path
 
     from rosl.bag.recorder import Recorder
     from rosl.node.lockstep import LockstepSource
     from rosl.node.node import Node
     from rosl.node.publisher import Publisher
+    from rosl.sim.options import SimOptions
     from rosl.sim.simulation import SimRobot, Simulation
 
 NS = 1_000_000_000
-
-
-@dataclass(slots=True)
-class SimOptions:
-    """How to run a simulation (``rosl sim``'s options)."""
-
-    real_time_factor: float = 1.0
-    fast: bool = False
-    duration: float | None = None
-    record: Path | None = None
-    render: Path | None = None
-    headless: bool = False
-    wait_for: list[str] = field(default_factory=list)
-    startup_timeout: float = 10.0
-    lockstep_timeout: float = 5.0
-    on_stall: str = "continue"
-
-
-@dataclass(slots=True)
-class RobotReport:
-    """What one robot did."""
-
-    name: str
-    distance: float
-    closest: float
-    collisions: int
-    pose: tuple[float, float, float]
-
-
-@dataclass(slots=True)
-class SimReport:
-    """What a run did, for the summary."""
-
-    world: str
-    sim_seconds: float
-    wall_seconds: float
-    mode: str
-    robots: list[RobotReport]
-    recorded: dict[str, int] = field(default_factory=dict)
-    bag: Path | None = None
-    picture: Path | None = None
-    stalls: int = 0
-    warnings: list[str] = field(default_factory=list)
-
-    def lines(self) -> list[str]:
-        """The summary printed at the end of a run."""
-        factor = self.sim_seconds / self.wall_seconds if self.wall_seconds > 0 else math.inf
-        out = [
-            f"simulated {self.sim_seconds:.2f} s of {self.world} in {self.wall_seconds:.2f} s "
-            f"({factor:.1f}x real time, {self.mode})"
-        ]
-        for robot in self.robots:
-            closest = (
-                "nothing within 5 m" if math.isinf(robot.closest) else (f"{robot.closest:.2f} m")
-            )
-            hits = (
-                "no collisions"
-                if robot.collisions == 0
-                else (f"{robot.collisions} collision{'s' if robot.collisions != 1 else ''}")
-            )
-            x, y, yaw = robot.pose
-            out.append(
-                f"  {robot.name}: drove {robot.distance:.2f} m, closest approach to an obstacle "
-                f"{closest}, {hits}; ends at x={x:.2f} y={y:.2f} yaw={yaw:.2f}"
-            )
-        out += [f"  cmd_vel {warning}" for warning in self.warnings]
-        if self.stalls:
-            out.append(f"  lock-step: went on without a silent controller {self.stalls} time(s)")
-        if self.bag is not None:
-            total = sum(self.recorded.values())
-            out.append(f"  recorded {total} messages to {self.bag}/:")
-            width = max((len(t) for t in self.recorded), default=0)
-            out += [f"    {t:<{width}}  {n}" for t, n in sorted(self.recorded.items())]
-        if self.picture is not None:
-            out.append(f"  picture of the run: {self.picture}")
-        return out
 
 
 class _Topic:
@@ -476,45 +401,3 @@ class SimNode:
 
             report.picture = render_simulation(self.sim, options.render)
         return report
-
-
-def parse_arguments(argv: list[str]) -> tuple[Path, SimOptions, int | None]:
-    """``sim WORLD [options]`` as the executable of package rosl_sim takes them."""
-    import argparse
-
-    parser = argparse.ArgumentParser(prog="sim", description="rosl's 2D simulator as a node")
-    parser.add_argument("world")
-    parser.add_argument("--real-time-factor", type=float, default=1.0)
-    parser.add_argument("--fast", action="store_true")
-    parser.add_argument("--duration", type=float)
-    parser.add_argument("--seed", type=int)
-    parser.add_argument("--record", type=Path)
-    parser.add_argument("--render", type=Path)
-    parser.add_argument("--headless", action="store_true")
-    parser.add_argument("--wait-for", action="append", default=[])
-    parser.add_argument("--startup-timeout", type=float, default=10.0)
-    parser.add_argument("--lockstep-timeout", type=float, default=5.0)
-    parser.add_argument("--on-stall", choices=["continue", "stop"], default="continue")
-    args = parser.parse_args(argv)
-    options = SimOptions(
-        real_time_factor=args.real_time_factor,
-        fast=args.fast,
-        duration=args.duration,
-        record=args.record,
-        render=args.render,
-        headless=args.headless,
-        wait_for=args.wait_for,
-        startup_timeout=args.startup_timeout,
-        lockstep_timeout=args.lockstep_timeout,
-        on_stall=args.on_stall,
-    )
-    return Path(args.world), options, args.seed
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of ``rosl run rosl_sim sim WORLD ...`` (and of ``rosl sim``)."""
-    from rosl.sim.runner import run_sim
-
-    if argv is None:
-        argv = sys.argv[1:]
-    return run_sim(argv)

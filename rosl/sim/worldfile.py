@@ -8,261 +8,49 @@ each other. Geometry is in metres and radians, poses are ``[x, y, yaw]``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from rosl.sim.errors import WorldFileError
+from rosl.sim.model import (
+    Circle,
+    DynamicBody,
+    Frame,
+    Lidar,
+    Point,
+    Polygon,
+    RobotModel,
+    RobotSpec,
+    Segment,
+    Shape,
+    World,
+)
+from rosl.sim.yaml_reader import LINE as _LINE
+from rosl.sim.yaml_reader import LINES as _LINES
+from rosl.sim.yaml_reader import YamlReader as _Reader
+
+__all__ = [  # the records live in model.py; importing them from here keeps working
+    "ROBOT_FORMAT",
+    "WORLD_FORMAT",
+    "Circle",
+    "DynamicBody",
+    "Frame",
+    "Lidar",
+    "Point",
+    "Polygon",
+    "RobotModel",
+    "RobotSpec",
+    "Segment",
+    "Shape",
+    "World",
+    "load_robot",
+    "load_world",
+    "resolve_world",
+]
 
 WORLD_FORMAT = "rosl-world/1"
 ROBOT_FORMAT = "rosl-robot/1"
-_LINES = "__lines__"
-_LINE = "__line__"
 
-Point = tuple[float, float]
-
-
-class _Loader(yaml.SafeLoader):
-    """Remembers the line of every mapping and of each of its keys."""
-
-
-def _mapping(loader: _Loader, node: yaml.MappingNode) -> dict[str, Any]:
-    mapping = loader.construct_mapping(node, deep=True)
-    mapping[_LINE] = node.start_mark.line + 1
-    mapping[_LINES] = {k.value: k.start_mark.line + 1 for k, _ in node.value}
-    return mapping
-
-
-_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping)
-
-
-@dataclass(frozen=True, slots=True)
-class Circle:
-    """A circle obstacle (static or a dynamic body's shape)."""
-
-    name: str
-    center: Point
-    radius: float
-
-
-@dataclass(frozen=True, slots=True)
-class Polygon:
-    """A convex polygon obstacle (counter-clockwise points)."""
-
-    name: str
-    points: tuple[Point, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class Segment:
-    """A thin wall: a segment with a radius."""
-
-    name: str
-    a: Point
-    b: Point
-    radius: float = 0.01
-
-
-Shape = Circle | Polygon | Segment
-
-
-@dataclass(frozen=True, slots=True)
-class DynamicBody:
-    """A movable body: its shape, mass, and whether it is kinematic (moved by code)."""
-
-    shape: Shape
-    mass: float
-    kinematic: bool
-
-
-@dataclass(frozen=True, slots=True)
-class Lidar:
-    """A 2D laser scanner (Gazebo's ray sensor conventions)."""
-
-    name: str
-    frame_id: str
-    topic: str
-    rate: float
-    samples: int
-    angle_min: float
-    angle_max: float
-    range_min: float
-    range_max: float
-    noise_stddev: float = 0.0
-    xy: Point = (0.0, 0.0)  # mount position in the robot frame (from frames when absent)
-
-
-@dataclass(frozen=True, slots=True)
-class Frame:
-    """A fixed frame of the robot (published once on /tf_static)."""
-
-    name: str
-    parent: str
-    xyz: tuple[float, float, float]
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    joint: str | None = None  # a wheel: turns about its z axis with this joint (on /tf)
-
-
-@dataclass(frozen=True, slots=True)
-class RobotModel:
-    """A robot model: footprint, drive, frames and sensors."""
-
-    name: str
-    footprint: Circle | Polygon
-    mass: float
-    wheel_separation: float
-    wheel_radius: float
-    max_linear: float
-    max_angular: float
-    max_linear_accel: float
-    cmd_vel: str
-    odom_topic: str
-    odom_frame: str
-    base_frame: str
-    odom_rate: float
-    joint_states_topic: str | None
-    joint_states_rate: float
-    joints: tuple[str, ...]
-    frames: tuple[Frame, ...]
-    lidars: tuple[Lidar, ...]
-    path: Path | None = None
-
-
-@dataclass(frozen=True, slots=True)
-class RobotSpec:
-    """A robot placed in a world."""
-
-    name: str
-    model: RobotModel
-    pose: tuple[float, float, float]
-    namespace: str
-
-
-@dataclass(frozen=True, slots=True)
-class World:
-    """A parsed world file."""
-
-    name: str
-    path: Path | None
-    step_ns: int
-    iterations: int
-    seed: int
-    statics: tuple[Shape, ...]
-    dynamics: tuple[DynamicBody, ...]
-    robots: tuple[RobotSpec, ...]
-    extra: dict[str, Any] = field(default_factory=dict)
-
-
-class _Reader:
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def fail(self, line: int, message: str) -> WorldFileError:
-        return WorldFileError(f"{self.path}:{line}: {message}")
-
-    def load(self) -> dict[str, Any]:
-        try:
-            data = yaml.load(self.path.read_text(encoding="utf-8"), Loader=_Loader)
-        except yaml.YAMLError as err:
-            mark = getattr(err, "problem_mark", None)
-            line = mark.line + 1 if mark is not None else 0
-            raise WorldFileError(
-                f"{self.path}:{line}: not valid YAML: {getattr(err, 'problem', err)}"
-            ) from None
-        except OSError as err:
-            raise WorldFileError(f"{self.path}: cannot read: {err.strerror}") from None
-        if not isinstance(data, dict):
-            raise self.fail(1, "expected a mapping with 'format:' at the top")
-        return data
-
-    def keys(self, entry: dict[str, Any], allowed: set[str], required: set[str], what: str) -> None:
-        line = entry.get(_LINE, 0)
-        for key in entry:
-            if key in (_LINE, _LINES):
-                continue
-            if key not in allowed:
-                from rosl.idl.names import did_you_mean
-
-                hint = did_you_mean(key, allowed)
-                raise self.fail(
-                    self.line_of(entry, key),
-                    f"unknown key '{key}' in {what}{hint} (expected: {', '.join(sorted(allowed))})",
-                )
-        for key in sorted(required):
-            if key not in entry:
-                raise self.fail(line, f"{what} needs '{key}:'")
-
-    @staticmethod
-    def line_of(entry: dict[str, Any], key: str) -> int:
-        return int(entry.get(_LINES, {}).get(key, entry.get(_LINE, 0)))
-
-    def number(
-        self,
-        entry: dict[str, Any],
-        key: str,
-        *,
-        default: float | None = None,
-        positive: bool = False,
-        minimum: float | None = None,
-    ) -> float:
-        if key not in entry:
-            if default is None:
-                raise self.fail(entry.get(_LINE, 0), f"missing '{key}:' (a number)")
-            return default
-        value = entry[key]
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, (int, float))
-            or not math.isfinite(value)
-        ):
-            raise self.fail(self.line_of(entry, key), f"'{key}' must be a number, not {value!r}")
-        if positive and value <= 0:
-            raise self.fail(
-                self.line_of(entry, key), f"'{key}' must be greater than 0, not {value}"
-            )
-        if minimum is not None and value < minimum:
-            raise self.fail(
-                self.line_of(entry, key), f"'{key}' must be at least {minimum}, not {value}"
-            )
-        return float(value)
-
-    def point(self, entry: dict[str, Any], key: str, size: int = 2) -> tuple[float, ...]:
-        value = entry.get(key)
-        if (
-            not isinstance(value, list)
-            or len(value) != size
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
-        ):
-            shape = "[x, y]" if size == 2 else "[x, y, yaw]" if size == 3 else f"{size} numbers"
-            raise self.fail(self.line_of(entry, key), f"'{key}' must be {shape}, not {value!r}")
-        return tuple(float(v) for v in value)
-
-    def text(self, entry: dict[str, Any], key: str, default: str | None = None) -> str:
-        value = entry.get(key, default)
-        if not isinstance(value, str):
-            raise self.fail(self.line_of(entry, key), f"'{key}' must be text, not {value!r}")
-        return value
-
-    def points(self, entry: dict[str, Any], key: str, minimum: int) -> list[Point]:
-        value = entry.get(key)
-        line = self.line_of(entry, key)
-        if not isinstance(value, list) or len(value) < minimum:
-            raise self.fail(line, f"'{key}' must be a list of at least {minimum} [x, y] points")
-        out = []
-        for item in value:
-            if (
-                not isinstance(item, list)
-                or len(item) != 2
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in item)
-            ):
-                raise self.fail(line, f"each of '{key}' must be [x, y], not {item!r}")
-            out.append((float(item[0]), float(item[1])))
-        return out
-
-
-# --- shapes ---------------------------------------------------------------------------------
 
 _SHAPE_KEYS = {
     "cylinder": ({"type", "name", "center", "radius"}, {"center", "radius"}),
