@@ -142,6 +142,7 @@ class Reader:
     def __init__(self) -> None:
         self.wanted: set[int] = set()  # topic hashes someone in this process listens to
         self.want_all = False  # recorders and monitors take every topic
+        self.ignored: set[int] = set()  # topic hashes never taken, even with want_all
         self.foreign = 0  # datagrams that are not rosl's (or from another protocol version)
         self.unwanted = 0  # rosl datagrams of topics nobody here listens to
         self.streams: dict[tuple[int, int], StreamStats] = {}
@@ -157,7 +158,7 @@ class Reader:
         Returns:
             True when the socket may hold more (the limit was reached).
         """
-        wanted, want_all = self.wanted, self.want_all
+        wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
         recv = sock.recv
         if self.reassembler.pending:  # drop (and count) messages whose fragments stopped coming
             now = time.time_ns()
@@ -181,7 +182,7 @@ class Reader:
             if version != _VERSION or count == 0 or index >= count:
                 self.foreign += 1
                 continue
-            if not want_all and topic not in wanted:
+            if (not want_all and topic not in wanted) or topic in ignored:
                 self.unwanted += 1
                 continue
             if count == 1:

@@ -15,7 +15,7 @@ import select
 import threading
 from typing import TYPE_CHECKING, Protocol
 
-from rosl.bus.header import Flags
+from rosl.bus.header import Flags, topic_hash
 from rosl.bus.multicast import addressing_from_env
 from rosl.bus.transport import MulticastTransport, channel_of
 from rosl.bus.wire import Delivery, Reader, Writer
@@ -158,9 +158,11 @@ class Participant:
     def listen_all(self) -> None:
         """Receive every topic on every channel (for recorders and monitors)."""
         from rosl.bus.multicast import CHANNELS
+        from rosl.node.lockstep import TOPIC as LOCKSTEP_TOPIC
 
         with self._lock:
             self.reader.want_all = True
+            self.reader.ignored.add(topic_hash(LOCKSTEP_TOPIC))  # lock-step answers: control only
             for channel in range(1, CHANNELS + 1):
                 if channel not in self._sockets:
                     self._sockets[channel] = self.transport.open(channel)
