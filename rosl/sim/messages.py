@@ -10,7 +10,6 @@ robot's odometry frame at its spawn pose.
 from __future__ import annotations
 
 import math
-from functools import cache
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
@@ -31,9 +30,8 @@ WORLD_FRAME = "world"
 POSE_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
 
 
-@cache
 def msg(type_name: str) -> Any:
-    """A message class (cached)."""
+    """A message class (the registry caches it)."""
     return get_message_class(type_name)
 
 
