@@ -126,7 +126,7 @@ def test_run_of_an_unknown_executable_lists_the_package_executables_closest_firs
     line = one_error_line(err)
     assert line == (
         "no executable 'timer_nod' in package 'tutorial_pkg'; it has: "
-        "timer_node, count_images, my_publisher, my_subscriber"
+        "timer_node, count_images, my_publisher, my_subscriber, velocity_controller"
     )
 
 
