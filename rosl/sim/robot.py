@@ -3,7 +3,10 @@
 The command is clamped to the model's limits and ramped at its acceleration limit; each
 physics step sets the body's velocity from inside ``velocity_func``, so pymunk's contact
 solver still stops the robot at walls (writing velocities before ``step()`` would tunnel).
-Odometry is the body's motion relative to its spawn pose, in the ``odom`` frame.
+A groove joint along the heading, moved before every step, is the wheels' grip: the solver
+cannot slide the robot sideways, so pushing on against an obstacle stalls it where it hit,
+as on Gazebo or a real floor. Odometry is the body's motion relative to its spawn pose, in
+the ``odom`` frame.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ if TYPE_CHECKING:
     from rosl.sim.worldfile import RobotSpec
 
 ABSURD = 1e3  # m/s or rad/s: a command beyond this is a bug upstream, not a wish
+GROOVE = 1e3  # metres: half the length of the line the robot may move along in one step
 
 
 class DiffDriveRobot:
@@ -39,7 +43,9 @@ class DiffDriveRobot:
         self.body.angle = spec.pose[2]
         self.shape = _pymunk_shape(self.body, foot, local=True)
         self.shape.friction = 0.0
-        space.add(self.body, self.shape)
+        self.grip = pymunk.GrooveJoint(space.static_body, self.body, (0, 0), (1, 0), (0, 0))
+        space.add(self.body, self.shape, self.grip)
+        self.before_step(0.0)
         self.body.velocity_func = self._velocity
         self.target = (0.0, 0.0)
         self.v = 0.0
@@ -81,6 +87,20 @@ class DiffDriveRobot:
         angle = body.angle
         body.velocity = (self.v * math.cos(angle), self.v * math.sin(angle))
         body.angular_velocity = self.w
+
+    def before_step(self, dt: float) -> None:
+        """Put the wheels' grip along the heading, through where the robot is about to be.
+
+        pymunk moves the body first and solves the constraints after, so the groove goes
+        where this step's motion takes the body, along the heading it will have there.
+        """
+        body = self.body
+        x = body.position.x + body.velocity.x * dt
+        y = body.position.y + body.velocity.y * dt
+        angle = body.angle + body.angular_velocity * dt
+        dx, dy = GROOVE * math.cos(angle), GROOVE * math.sin(angle)
+        self.grip.groove_a = (x - dx, y - dy)
+        self.grip.groove_b = (x + dx, y + dy)
 
     def after_step(self, dt: float) -> None:
         """Advance the wheel joints with the motion the solver allowed."""

@@ -104,6 +104,8 @@ class Simulation:
     def step(self) -> None:
         """Advance the physics by one fixed step."""
         dt = self.step_ns / NS
+        for sim_robot in self.robots:
+            sim_robot.robot.before_step(dt)
         self.space.space.step(dt)
         self.now_ns += self.step_ns
         self.steps += 1
@@ -130,12 +132,36 @@ class Simulation:
     def _sample(self, sim_robot: SimRobot) -> None:
         x, y, yaw = sim_robot.robot.pose
         sim_robot.path.append((self.now_ns, x, y, yaw))
-        query = self.space.space.point_query_nearest(
-            (x, y), CLEARANCE_REACH, sim_robot.robot.shape.filter
-        )
-        if query is not None:
-            clearance = query.distance - _inscribed(sim_robot.robot.spec.model.footprint)
-            sim_robot.closest = min(sim_robot.closest, clearance)
+        shape = sim_robot.robot.shape
+        query = self.space.space.point_query_nearest((x, y), CLEARANCE_REACH, shape.filter)
+        if query is None:
+            return
+        footprint = sim_robot.robot.spec.model.footprint
+        if isinstance(footprint, Circle):
+            sim_robot.closest = min(sim_robot.closest, query.distance - footprint.radius)
+        elif query.distance - _circumscribed(footprint) < sim_robot.closest:  # could be closer
+            sim_robot.closest = min(sim_robot.closest, self._clearance(shape, query.distance))
+
+    def _clearance(self, robot: pymunk.Shape, reach: float) -> float:
+        """The exact gap between a polygon footprint and the nearest obstacle (0 on contact).
+
+        Between convex shapes the gap is reached at a corner of one of them: the footprint's
+        corners are asked of the space, the obstacles' corners (centres, ends) of the footprint.
+        """
+        assert isinstance(robot, pymunk.Poly)
+        space, body = self.space.space, robot.body
+        corners = [body.local_to_world(v) for v in robot.get_vertices()]
+        best = math.inf
+        for corner in corners:
+            hit = space.point_query_nearest(corner, CLEARANCE_REACH, robot.filter)
+            if hit is not None:
+                best = min(best, hit.distance)
+        box = robot.bb
+        near = pymunk.BB(box.left - reach, box.bottom - reach, box.right + reach, box.top + reach)
+        for other in space.bb_query(near, robot.filter):
+            for point, radius in _features(other):
+                best = min(best, robot.point_query(point).distance - radius)
+        return max(0.0, best)
 
     # --- sensors -----------------------------------------------------------------------------
 
@@ -154,17 +180,23 @@ class Simulation:
         return ranges
 
 
-def _inscribed(footprint: Circle | Polygon) -> float:
-    """The radius of the largest circle inside a footprint centred on the robot."""
-    if isinstance(footprint, Circle):
-        return footprint.radius
-    points = footprint.points
-    best = math.inf
-    for k, (x1, y1) in enumerate(points):
-        x2, y2 = points[(k + 1) % len(points)]
-        length = math.hypot(x2 - x1, y2 - y1) or 1.0
-        best = min(best, abs(x1 * y2 - x2 * y1) / length)
-    return best
+def _circumscribed(footprint: Polygon) -> float:
+    """The distance from the robot's centre to its footprint's farthest corner."""
+    return max(math.hypot(x, y) for x, y in footprint.points)
+
+
+def _features(shape: pymunk.Shape) -> list[tuple[tuple[float, float], float]]:
+    """An obstacle's corners (or centre, or ends) in the world, with its rounding radius."""
+    body = shape.body
+    if isinstance(shape, pymunk.Circle):
+        return [(body.local_to_world(shape.offset), shape.radius)]
+    if isinstance(shape, pymunk.Segment):
+        return [
+            (body.local_to_world(shape.a), shape.radius),
+            (body.local_to_world(shape.b), shape.radius),
+        ]
+    assert isinstance(shape, pymunk.Poly)
+    return [(body.local_to_world(v), shape.radius) for v in shape.get_vertices()]
 
 
 def _robot_geometry(robots: list[SimRobot]) -> Geometry:

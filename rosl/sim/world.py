@@ -24,14 +24,49 @@ def _pymunk_shape(body: pymunk.Body, shape: Shape, *, local: bool = False) -> py
     return pymunk.Segment(body, shape.a, shape.b, shape.radius)
 
 
+def _pymunk_shapes(body: pymunk.Body, shape: Shape) -> list[pymunk.Shape]:
+    """The pymunk shapes of an obstacle: a polygon that is not convex in convex pieces.
+
+    ``pymunk.Poly`` takes the convex hull of its points, so an L-shaped wall would collide
+    where the LiDAR sees free space; pymunk's own decomposition (exact at tolerance 0) keeps
+    the two in agreement.
+    """
+    if isinstance(shape, Polygon) and not _convex(shape.points):
+        from pymunk.autogeometry import convex_decomposition
+
+        points = list(shape.points)
+        if _area(points) < 0:
+            points.reverse()
+        hulls = convex_decomposition([*points, points[0]], 0.0)
+        return [pymunk.Poly(body, [tuple(p) for p in hull[:-1]]) for hull in hulls]
+    return [_pymunk_shape(body, shape)]
+
+
+def _area(points: list[tuple[float, float]]) -> float:
+    """Twice the signed area (positive counter-clockwise)."""
+    return sum(
+        a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:] + points[:1], strict=True)
+    )
+
+
+def _convex(points: tuple[tuple[float, float], ...]) -> bool:
+    n = len(points)
+    turns = [
+        (points[(k + 1) % n][0] - points[k][0]) * (points[(k + 2) % n][1] - points[k][1])
+        - (points[(k + 1) % n][1] - points[k][1]) * (points[(k + 2) % n][0] - points[k][0])
+        for k in range(n)
+    ]
+    return all(t >= 0 for t in turns) or all(t <= 0 for t in turns)
+
+
 def footprint_overlaps(robot: RobotSpec, statics: tuple[Shape, ...]) -> str | None:
     """The name of a static shape the robot's spawn footprint overlaps, if any."""
     space = pymunk.Space()
     names: dict[pymunk.Shape, str] = {}
     for shape in statics:
-        made = _pymunk_shape(space.static_body, shape)
-        names[made] = shape.name
-        space.add(made)
+        for made in _pymunk_shapes(space.static_body, shape):
+            names[made] = shape.name
+            space.add(made)
     body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
     body.position = robot.pose[:2]
     body.angle = robot.pose[2]
@@ -57,19 +92,20 @@ class Geometry:
                 circles.append((*shape.center, shape.radius))
             elif isinstance(shape, Polygon):
                 points = list(shape.points)
-                area = sum(
-                    a[0] * b[1] - b[0] * a[1]
-                    for a, b in zip(points, points[1:] + points[:1], strict=True)
-                )
-                if area < 0:
+                if _area(points) < 0:
                     points.reverse()
                 for k, (x1, y1) in enumerate(points):
                     x2, y2 = points[(k + 1) % len(points)]
                     segments.append((x1, y1, x2, y2))
                     closed.append(True)
-            elif isinstance(shape, Segment):
-                segments.append((*shape.a, *shape.b))
-                closed.append(False)
+            elif isinstance(shape, Segment):  # pymunk's capsule: two sides and two round ends
+                (ax, ay), (bx, by) = shape.a, shape.b
+                length = math.hypot(bx - ax, by - ay) or 1.0
+                nx, ny = -(by - ay) / length * shape.radius, (bx - ax) / length * shape.radius
+                for dx, dy in ((nx, ny), (-nx, -ny)):
+                    segments.append((ax + dx, ay + dy, bx + dx, by + dy))
+                    closed.append(False)
+                circles += [(ax, ay, shape.radius), (bx, by, shape.radius)]
         self.segments = np.array(segments, dtype=np.float64).reshape(-1, 4)
         self.closed = np.array(closed, dtype=bool)
         self.circles = np.array(circles, dtype=np.float64).reshape(-1, 3)
@@ -108,9 +144,9 @@ class WorldSpace:
         self.space.gravity = (0.0, 0.0)
         self.space.iterations = world.iterations
         for shape in world.statics:
-            made = _pymunk_shape(self.space.static_body, shape)
-            made.friction = 0.0
-            self.space.add(made)
+            for made in _pymunk_shapes(self.space.static_body, shape):
+                made.friction = 0.0
+                self.space.add(made)
         self.bodies: list[tuple[pymunk.Body, Shape]] = []
         for dynamic in world.dynamics:
             self._add_body(dynamic.shape, dynamic.mass, dynamic.kinematic)
@@ -122,16 +158,18 @@ class WorldSpace:
         if kinematic:
             body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         else:
-            moment = (
-                pymunk.moment_for_circle(mass, 0, local.radius)
-                if isinstance(local, Circle)
-                else pymunk.moment_for_box(mass, (1.0, 1.0))
-            )
+            if isinstance(local, Circle):
+                moment = pymunk.moment_for_circle(mass, 0, local.radius, local.center)
+            elif isinstance(local, Polygon):
+                moment = pymunk.moment_for_poly(mass, list(local.points))
+            else:
+                moment = pymunk.moment_for_segment(mass, local.a, local.b, local.radius)
             body = pymunk.Body(mass, moment)
         body.position = center
-        made = _pymunk_shape(body, local, local=False)
-        made.friction = 0.5
-        self.space.add(body, made)
+        self.space.add(body)
+        for made in _pymunk_shapes(body, local):
+            made.friction = 0.5
+            self.space.add(made)
         self.bodies.append((body, local))
 
     def dynamic_geometry(self) -> Geometry:
@@ -149,6 +187,16 @@ class WorldSpace:
                     Polygon(
                         local.name,
                         tuple((px + c * x - s * y, py + s * x + c * y) for x, y in local.points),
+                    )
+                )
+            else:
+                (ax, ay), (bx, by) = local.a, local.b
+                placed.append(
+                    Segment(
+                        local.name,
+                        (px + c * ax - s * ay, py + s * ax + c * ay),
+                        (px + c * bx - s * by, py + s * bx + c * by),
+                        local.radius,
                     )
                 )
         return Geometry(tuple(placed))

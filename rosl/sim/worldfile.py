@@ -78,17 +78,21 @@ def _box(center: Point, size: tuple[float, ...], yaw: float) -> list[Point]:
     ]
 
 
-def _ccw(points: list[Point]) -> list[Point]:
-    area = sum(
+def _area(points: list[Point]) -> float:
+    """Twice the signed area (positive when the points run counter-clockwise)."""
+    return sum(
         a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:] + points[:1], strict=True)
     )
-    return points if area > 0 else points[::-1]
 
 
-def _shapes(reader: _Reader, entry: Any, extra: set[str] = frozenset()) -> list[Shape]:
-    if not isinstance(entry, dict) or "type" not in entry:
-        line = entry.get(_LINE, 0) if isinstance(entry, dict) else 0
-        raise reader.fail(line, f"each shape needs 'type:' ({', '.join(_SHAPE_KEYS)})")
+def _ccw(points: list[Point]) -> list[Point]:
+    return points if _area(points) > 0 else points[::-1]
+
+
+def _shapes(reader: _Reader, item: Any, line: int, extra: set[str] = frozenset()) -> list[Shape]:
+    entry = reader.item(line, item, "a shape with 'type:'")
+    if "type" not in entry:
+        raise reader.fail(entry[_LINE], f"each shape needs 'type:' ({', '.join(_SHAPE_KEYS)})")
     kind = entry["type"]
     if kind not in _SHAPE_KEYS:
         raise reader.fail(
@@ -97,37 +101,25 @@ def _shapes(reader: _Reader, entry: Any, extra: set[str] = frozenset()) -> list[
         )
     allowed, required = _SHAPE_KEYS[kind]
     reader.keys(entry, allowed | extra, required, f"a {kind}")
-    name = str(entry.get("name", kind))
+    name = reader.text(entry, "name", kind)
     if kind == "cylinder":
-        return [
-            Circle(
-                name, reader.point(entry, "center"), reader.number(entry, "radius", positive=True)
-            )
-        ]  # type: ignore[arg-type]
+        center = reader.point(entry, "center")
+        return [Circle(name, center, reader.number(entry, "radius", positive=True))]  # type: ignore[arg-type]
     if kind == "box":
         size = reader.point(entry, "size")
         if min(size) <= 0:
             raise reader.fail(
                 reader.line_of(entry, "size"), f"'size' must be positive, not {list(size)}"
             )
-        return [
-            Polygon(
-                name,
-                tuple(
-                    _box(
-                        reader.point(entry, "center"),
-                        size,
-                        reader.number(entry, "yaw", default=0.0),
-                    )
-                ),
-            )
-        ]  # type: ignore[arg-type]
+        center = reader.point(entry, "center")
+        yaw = reader.number(entry, "yaw", default=0.0)
+        return [Polygon(name, tuple(_box(center, size, yaw)))]  # type: ignore[arg-type]
     if kind == "segment":
         a, b = reader.points(entry, "points", 2)[:2]
         return [Segment(name, a, b, reader.number(entry, "radius", default=0.01, positive=True))]
     if kind == "regular_polygon":
         center = reader.point(entry, "center")
-        sides = int(reader.number(entry, "sides", minimum=3))
+        sides = reader.integer(entry, "sides", minimum=3)
         radius = reader.number(entry, "circumradius", positive=True)
         yaw = reader.number(entry, "yaw", default=0.0)
         points = [
@@ -140,15 +132,25 @@ def _shapes(reader: _Reader, entry: Any, extra: set[str] = frozenset()) -> list[
         return [Polygon(name, tuple(points))]
     if kind == "polygon":
         points = reader.points(entry, "points", 3)
-        if not entry.get("ring"):
+        _check_simple(reader, reader.line_of(entry, "points"), points)
+        if not reader.flag(entry, "ring"):
             return [Polygon(name, tuple(_ccw(points)))]
         thickness = reader.number(entry, "thickness", positive=True)
         return _ring(name, _ccw(points), thickness)
-    # grid
-    shape = entry["shape"]
+    return _grid(reader, entry, name)
+
+
+def _grid(reader: _Reader, entry: dict[str, Any], name: str) -> list[Shape]:
+    """A shape repeated ``count`` times, ``step`` apart, from ``origin``."""
+    shape = reader.mapping(entry, "shape", "the shape to repeat, without 'center:'")
     origin = reader.point(entry, "origin")
     step = reader.point(entry, "step")
     count = reader.point(entry, "count")
+    if not all(c.is_integer() and c >= 1 for c in count):
+        raise reader.fail(
+            reader.line_of(entry, "count"),
+            f"'count' must be two whole numbers of at least 1, not {list(count)}",
+        )
     out: list[Shape] = []
     for i in range(int(count[0])):
         for j in range(int(count[1])):
@@ -156,8 +158,47 @@ def _shapes(reader: _Reader, entry: Any, extra: set[str] = frozenset()) -> list[
             item["center"] = [origin[0] + i * step[0], origin[1] + j * step[1]]
             item.setdefault("name", f"{name}_{i}_{j}")
             item[_LINES] = {**shape.get(_LINES, {}), "center": reader.line_of(entry, "origin")}
-            out += _shapes(reader, item)
+            out += _shapes(reader, item, shape[_LINE])
     return out
+
+
+def _check_simple(reader: _Reader, line: int, points: list[Point]) -> None:
+    """Refuse a polygon whose sides cross or that has no area (pymunk could not hold it)."""
+    n = len(points)
+    if abs(_area(points)) < 1e-12:
+        raise reader.fail(line, "'points' enclose no area")
+    for i in range(n):
+        for j in range(i + 1, n):
+            if j == i + 1 or (i == 0 and j == n - 1):
+                continue  # neighbours share a corner
+            if _crossing(points[i], points[(i + 1) % n], points[j], points[(j + 1) % n]):
+                raise reader.fail(
+                    line, f"the polygon's sides {i + 1} and {j + 1} cross; list its corners "
+                    "in order around it",
+                )  # fmt: skip
+
+
+def _crossing(a: Point, b: Point, c: Point, d: Point) -> bool:
+    """Whether the segments a-b and c-d touch or cross."""
+
+    def side(p: Point, q: Point, r: Point) -> float:
+        return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+
+    d1, d2, d3, d4 = side(c, d, a), side(c, d, b), side(a, b, c), side(a, b, d)
+    if ((d1 > 0) != (d2 > 0)) and ((d3 > 0) != (d4 > 0)) and 0 not in (d1, d2, d3, d4):
+        return True
+
+    def on(p: Point, q: Point, r: Point) -> bool:
+        return min(p[0], q[0]) <= r[0] <= max(p[0], q[0]) and min(p[1], q[1]) <= r[1] <= max(
+            p[1], q[1]
+        )
+
+    return (
+        (d1 == 0 and on(c, d, a))
+        or (d2 == 0 and on(c, d, b))
+        or (d3 == 0 and on(a, b, c))
+        or (d4 == 0 and on(a, b, d))
+    )
 
 
 def _ring(name: str, inner: list[Point], thickness: float) -> list[Shape]:
@@ -199,8 +240,35 @@ def _robot_model(name: str, world_path: Path | None, line: int, where: str) -> R
     )
 
 
+_DRIVE_KEYS = {
+    "wheel_separation",
+    "wheel_radius",
+    "max_linear",
+    "max_angular",
+    "max_linear_accel",
+    "cmd_vel",
+    "odom",
+    "joint_states",
+}
+_LIDAR_KEYS = {
+    "type",
+    "frame_id",
+    "topic",
+    "rate",
+    "samples",
+    "angle_min",
+    "angle_max",
+    "range_min",
+    "range_max",
+}
+
+
 def load_robot(path: Path) -> RobotModel:
-    """Read a robot model file."""
+    """Read a robot model file.
+
+    Raises:
+        WorldFileError: with file:line and what is expected.
+    """
     reader = _Reader(path)
     data = reader.load()
     reader.keys(
@@ -214,122 +282,111 @@ def load_robot(path: Path) -> RobotModel:
             reader.line_of(data, "format"),
             f"format must be '{ROBOT_FORMAT}', not {data['format']!r}",
         )
-    foot = data["footprint"]
-    if foot.get("type") == "circle":
-        reader.keys(foot, {"type", "radius"}, {"radius"}, "a circle footprint")
-        footprint: Circle | Polygon = Circle(
-            "footprint", (0.0, 0.0), reader.number(foot, "radius", positive=True)
-        )
-    elif foot.get("type") == "box":
-        reader.keys(foot, {"type", "size", "offset"}, {"size"}, "a box footprint")
-        offset = reader.point(foot, "offset") if "offset" in foot else (0.0, 0.0)
-        footprint = Polygon("footprint", tuple(_box(offset, reader.point(foot, "size"), 0.0)))  # type: ignore[arg-type]
-    else:
-        raise reader.fail(foot.get(_LINE, 0), "footprint type must be 'circle' or 'box'")
-    drive = data["drive"]
-    reader.keys(
-        drive,
-        {
-            "wheel_separation",
-            "wheel_radius",
-            "max_linear",
-            "max_angular",
-            "max_linear_accel",
-            "cmd_vel",
-            "odom",
-            "joint_states",
-        },
-        {"wheel_separation", "wheel_radius"},
-        "drive",
-    )
-    odom = drive.get("odom", {})
-    joints_entry = drive.get("joint_states")
-    frames = []
-    for frame_name, frame in (data.get("frames") or {}).items():
-        if frame_name in (_LINE, _LINES):
-            continue
-        reader.keys(
-            frame, {"parent", "xyz", "rpy", "joint"}, {"parent", "xyz"}, f"frame '{frame_name}'"
-        )
-        frames.append(
-            Frame(
-                frame_name,
-                reader.text(frame, "parent"),
-                reader.point(frame, "xyz", 3),  # type: ignore[arg-type]
-                reader.point(frame, "rpy", 3) if "rpy" in frame else (0.0, 0.0, 0.0),  # type: ignore[arg-type]
-                reader.text(frame, "joint") if "joint" in frame else None,
-            )
-        )
-    lidars = []
-    for sensor in data.get("sensors") or []:
-        reader.keys(
-            sensor,
-            {
-                "type",
-                "name",
-                "frame_id",
-                "topic",
-                "rate",
-                "samples",
-                "angle_min",
-                "angle_max",
-                "range_min",
-                "range_max",
-                "noise_stddev",
-                "xy",
-            },
-            {
-                "type",
-                "frame_id",
-                "topic",
-                "rate",
-                "samples",
-                "angle_min",
-                "angle_max",
-                "range_min",
-                "range_max",
-            },
-            "a sensor",
-        )
-        if sensor["type"] != "lidar2d":
-            raise reader.fail(reader.line_of(sensor, "type"), "sensor type must be 'lidar2d'")
-        frame_id = reader.text(sensor, "frame_id")
-        xy = reader.point(sensor, "xy") if "xy" in sensor else _frame_xy(frames, frame_id)
-        lidars.append(
-            Lidar(
-                str(sensor.get("name", "lidar")),
-                frame_id,
-                reader.text(sensor, "topic"),
-                reader.number(sensor, "rate", positive=True),
-                int(reader.number(sensor, "samples", minimum=1)),
-                reader.number(sensor, "angle_min"),
-                reader.number(sensor, "angle_max"),
-                reader.number(sensor, "range_min", minimum=0.0),
-                reader.number(sensor, "range_max", positive=True),
-                reader.number(sensor, "noise_stddev", default=0.0, minimum=0.0),
-                xy,  # type: ignore[arg-type]
-            )
-        )
+    drive = reader.mapping(data, "drive", "the wheels, limits and topics")
+    reader.keys(drive, _DRIVE_KEYS, {"wheel_separation", "wheel_radius"}, "drive")
+    odom = reader.mapping(drive, "odom", "topic, frame_id, child_frame_id, rate")
+    reader.keys(odom, {"topic", "frame_id", "child_frame_id", "rate"}, set(), "odom")
+    joints = reader.mapping(drive, "joint_states", "topic, rate, joints")
+    reader.keys(joints, {"topic", "rate", "joints"}, set(), "joint_states")
+    has_joints = "joint_states" in drive
+    frames = _frames(reader, data)
     return RobotModel(
-        name=str(data.get("name", path.stem)),
-        footprint=footprint,
+        name=reader.text(data, "name", path.stem),
+        footprint=_footprint(reader, data),
         mass=reader.number(data, "mass", default=1.0, positive=True),
         wheel_separation=reader.number(drive, "wheel_separation", positive=True),
         wheel_radius=reader.number(drive, "wheel_radius", positive=True),
         max_linear=reader.number(drive, "max_linear", default=1.0, positive=True),
         max_angular=reader.number(drive, "max_angular", default=2.0, positive=True),
         max_linear_accel=reader.number(drive, "max_linear_accel", default=1.0, positive=True),
-        cmd_vel=str(drive.get("cmd_vel", "cmd_vel")),
-        odom_topic=str(odom.get("topic", "odom")),
-        odom_frame=str(odom.get("frame_id", "odom")),
-        base_frame=str(odom.get("child_frame_id", "base_footprint")),
-        odom_rate=float(odom.get("rate", 30)),
-        joint_states_topic=str(joints_entry["topic"]) if joints_entry else None,
-        joint_states_rate=float(joints_entry.get("rate", 30)) if joints_entry else 0.0,
-        joints=tuple(joints_entry.get("joints", [])) if joints_entry else (),
-        frames=tuple(frames),
-        lidars=tuple(lidars),
+        cmd_vel=reader.text(drive, "cmd_vel", "cmd_vel"),
+        odom_topic=reader.text(odom, "topic", "odom"),
+        odom_frame=reader.text(odom, "frame_id", "odom"),
+        base_frame=reader.text(odom, "child_frame_id", "base_footprint"),
+        odom_rate=reader.number(odom, "rate", default=30.0, positive=True),
+        joint_states_topic=reader.text(joints, "topic", "joint_states") if has_joints else None,
+        joint_states_rate=reader.number(joints, "rate", default=30.0, positive=True)
+        if has_joints
+        else 0.0,
+        joints=reader.texts(joints, "joints"),
+        frames=frames,
+        lidars=tuple(_lidar(reader, line, item, frames) for line, item in reader.sequence(
+            data, "sensors", "sensors")),
         path=path,
+    )  # fmt: skip
+
+
+def _footprint(reader: _Reader, data: dict[str, Any]) -> Circle | Polygon:
+    foot = reader.mapping(data, "footprint", "type: circle or box")
+    if foot.get("type") == "circle":
+        reader.keys(foot, {"type", "radius"}, {"radius"}, "a circle footprint")
+        return Circle("footprint", (0.0, 0.0), reader.number(foot, "radius", positive=True))
+    if foot.get("type") == "box":
+        reader.keys(foot, {"type", "size", "offset"}, {"size"}, "a box footprint")
+        size = reader.point(foot, "size")
+        if min(size) <= 0:
+            raise reader.fail(
+                reader.line_of(foot, "size"), f"'size' must be positive, not {list(size)}"
+            )
+        offset = reader.point(foot, "offset") if "offset" in foot else (0.0, 0.0)
+        return Polygon("footprint", tuple(_box(offset, size, 0.0)))  # type: ignore[arg-type]
+    raise reader.fail(foot[_LINE], "footprint type must be 'circle' or 'box'")
+
+
+def _frames(reader: _Reader, data: dict[str, Any]) -> tuple[Frame, ...]:
+    frames = []
+    entries = reader.mapping(data, "frames", "frame name: {parent, xyz, rpy}")
+    for name in entries:
+        if name in (_LINE, _LINES):
+            continue
+        frame = reader.mapping(entries, name, "parent, xyz, rpy, joint")
+        reader.keys(frame, {"parent", "xyz", "rpy", "joint"}, {"parent", "xyz"}, f"frame '{name}'")
+        frames.append(
+            Frame(
+                str(name),
+                reader.text(frame, "parent"),
+                reader.point(frame, "xyz", 3),  # type: ignore[arg-type]
+                reader.point(frame, "rpy", 3) if "rpy" in frame else (0.0, 0.0, 0.0),  # type: ignore[arg-type]
+                reader.text(frame, "joint") if "joint" in frame else None,
+            )
+        )
+    return tuple(frames)
+
+
+def _lidar(reader: _Reader, line: int, item: Any, frames: tuple[Frame, ...]) -> Lidar:
+    sensor = reader.item(line, item, "a sensor with 'type: lidar2d'")
+    reader.keys(sensor, _LIDAR_KEYS | {"name", "noise_stddev", "xy"}, _LIDAR_KEYS, "a sensor")
+    if sensor["type"] != "lidar2d":
+        raise reader.fail(reader.line_of(sensor, "type"), "sensor type must be 'lidar2d'")
+    frame_id = reader.text(sensor, "frame_id")
+    xy = reader.point(sensor, "xy") if "xy" in sensor else _frame_xy(list(frames), frame_id)
+    samples = reader.integer(sensor, "samples", minimum=1)
+    angle_min = reader.number(sensor, "angle_min")
+    angle_max = reader.number(sensor, "angle_max")
+    if angle_max < angle_min or (samples > 1 and angle_max == angle_min):
+        raise reader.fail(
+            reader.line_of(sensor, "angle_max"),
+            f"'angle_max' ({angle_max}) must be greater than 'angle_min' ({angle_min})",
+        )
+    range_min = reader.number(sensor, "range_min", minimum=0.0)
+    range_max = reader.number(sensor, "range_max", positive=True)
+    if range_min >= range_max:
+        raise reader.fail(
+            reader.line_of(sensor, "range_min"),
+            f"'range_min' ({range_min}) must be less than 'range_max' ({range_max})",
+        )
+    return Lidar(
+        reader.text(sensor, "name", "lidar"),
+        frame_id,
+        reader.text(sensor, "topic"),
+        reader.number(sensor, "rate", positive=True),
+        samples,
+        angle_min,
+        angle_max,
+        range_min,
+        range_max,
+        reader.number(sensor, "noise_stddev", default=0.0, minimum=0.0),
+        xy,  # type: ignore[arg-type]
     )
 
 
@@ -367,54 +424,53 @@ def load_world(path: Path) -> World:
             reader.line_of(data, "format"),
             f"format must be '{WORLD_FORMAT}', not {data['format']!r}",
         )
-    physics = data.get("physics") or {_LINE: reader.line_of(data, "format")}
+    physics = reader.mapping(data, "physics", "step and iterations")
     reader.keys(physics, {"step", "iterations"}, set(), "physics")
     step = reader.number(physics, "step", default=0.01, positive=True)
-    seed = data.get("seed", 0)
-    if not isinstance(seed, int) or isinstance(seed, bool):
-        raise reader.fail(
-            reader.line_of(data, "seed"), f"'seed' must be a whole number, not {seed!r}"
-        )
+    seed = reader.integer(data, "seed", default=0)
     statics: list[Shape] = []
-    for entry in data.get("static") or []:
-        statics += _shapes(reader, entry)
+    for line, entry in reader.sequence(data, "static", "shapes"):
+        statics += _shapes(reader, entry, line)
     dynamics = []
-    for entry in data.get("dynamic") or []:
-        for shape in _shapes(reader, entry, _DYNAMIC_KEYS):
+    for line, entry in reader.sequence(data, "dynamic", "shapes with a mass"):
+        for shape in _shapes(reader, entry, line, _DYNAMIC_KEYS):
             dynamics.append(
                 DynamicBody(
                     shape,
                     reader.number(entry, "mass", default=1.0, positive=True),
-                    bool(entry.get("kinematic", False)),
+                    reader.flag(entry, "kinematic"),
                 )
             )
     robots = []
-    for entry in data.get("robots") or []:
+    entries = []
+    for line, item in reader.sequence(data, "robots", "robots"):
+        entry = reader.item(line, item, "a robot with 'model:' and 'pose:'")
         reader.keys(entry, {"name", "model", "pose", "namespace"}, {"model", "pose"}, "a robot")
         model = _robot_model(
             reader.text(entry, "model"), path, reader.line_of(entry, "model"), str(path)
         )
         pose = reader.point(entry, "pose", 3)
-        namespace = str(entry.get("namespace", "") or "").strip("/")
-        robots.append(RobotSpec(str(entry.get("name", model.name)), model, pose, namespace))  # type: ignore[arg-type]
+        namespace = reader.text(entry, "namespace", "").strip("/")
+        name = reader.text(entry, "name", model.name)
+        robots.append(RobotSpec(name, model, pose, namespace))  # type: ignore[arg-type]
+        entries.append(entry)
     world = World(
         str(data.get("name", path.stem)),
         path,
         round(step * 1e9),
-        int(reader.number(physics, "iterations", default=10, minimum=1)),
+        reader.integer(physics, "iterations", default=10, minimum=1),
         seed,
         tuple(statics),
         tuple(dynamics),
         tuple(robots),
     )
-    _check_spawns(reader, data, world)
+    _check_spawns(reader, entries, world)
     return world
 
 
-def _check_spawns(reader: _Reader, data: dict[str, Any], world: World) -> None:
+def _check_spawns(reader: _Reader, entries: list[dict[str, Any]], world: World) -> None:
     from rosl.sim.world import footprint_overlaps
 
-    entries = data.get("robots") or []
     for index, robot in enumerate(world.robots):
         line = reader.line_of(entries[index], "pose")
         hit = footprint_overlaps(robot, world.statics)

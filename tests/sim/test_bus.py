@@ -1,0 +1,161 @@
+"""``rosl sim`` on the real bus: topics and types, latched statics, the TF tree, /cmd_vel."""
+
+from __future__ import annotations
+
+import math
+import re
+import time
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from tests.launch.support import Rosl
+
+TOPICS = {
+    "/clock": "rosgraph_msgs/msg/Clock",
+    "/cmd_vel": "geometry_msgs/msg/Twist",
+    "/joint_states": "sensor_msgs/msg/JointState",
+    "/odom": "nav_msgs/msg/Odometry",
+    "/robot_description": "std_msgs/msg/String",
+    "/scan": "sensor_msgs/msg/LaserScan",
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/tf_static": "tf2_msgs/msg/TFMessage",
+}
+TREE = {
+    "base_footprint": "odom",
+    "base_link": "base_footprint",
+    "base_scan": "base_link",
+    "imu_link": "base_link",
+    "wheel_left_link": "base_link",
+    "wheel_right_link": "base_link",
+}
+
+
+class Inbox:
+    """The messages a node in the test process received, per topic."""
+
+    def __init__(self, ros: Any, node: Any) -> None:
+        self.ros = ros
+        self.node = node
+        self.got: dict[str, list[Any]] = {}
+
+    def listen(self, msg_type: Any, topic: str, qos: Any = 10) -> None:
+        self.node.create_subscription(
+            msg_type, topic, lambda m: self.got.setdefault(topic, []).append(m), qos
+        )
+
+    def spin_until(self, done: Callable[[], bool], timeout: float) -> bool:
+        deadline = time.monotonic() + timeout
+        while not done() and time.monotonic() < deadline:
+            self.ros.spin_once(self.node, timeout_sec=0.05)
+        return done()
+
+    def latest(self, topic: str) -> Any:
+        return self.got[topic][-1]
+
+
+def odom_x(inbox: Inbox) -> float:
+    return inbox.latest("/odom").pose.pose.position.x
+
+
+@pytest.mark.slow
+def test_a_paced_sim_publishes_its_topics_tf_tree_and_follows_cmd_vel(rosl: Rosl, ros: Any) -> None:
+    from geometry_msgs.msg import Twist  # noqa: F401 - the type must resolve in this process
+    from nav_msgs.msg import Odometry
+    from rosgraph_msgs.msg import Clock
+    from sensor_msgs.msg import JointState, LaserScan
+    from std_msgs.msg import String
+    from tf2_msgs.msg import TFMessage
+
+    from rosl.node.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
+
+    sim = rosl.start("sim", "empty", "--real-time-factor", "2", "--headless")
+    inbox = Inbox(ros, ros.Node("sim_probe"))
+    for msg_type, topic in [(Clock, "/clock"), (Odometry, "/odom"), (JointState, "/joint_states")]:
+        inbox.listen(msg_type, topic)
+    inbox.listen(TFMessage, "/tf")
+    inbox.listen(LaserScan, "/scan", qos_profile_sensor_data)
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    inbox.listen(String, "/robot_description", latched)
+    everything = ["/clock", "/odom", "/joint_states", "/tf", "/scan", "/robot_description"]
+    assert inbox.spin_until(lambda: all(t in inbox.got for t in everything), 20.0), (
+        sorted(inbox.got),
+        sim.both(),
+    )
+
+    # a late subscriber still gets /tf_static (transient local), sent once at the start
+    inbox.spin_until(lambda: False, 0.5)
+    inbox.listen(TFMessage, "/tf_static", latched)
+    assert inbox.spin_until(lambda: "/tf_static" in inbox.got, 10.0), sim.both()
+    static = {
+        t.child_frame_id: t.header.frame_id for m in inbox.got["/tf_static"] for t in m.transforms
+    }
+    for child in ("base_link", "base_scan", "imu_link"):
+        assert static[child] == TREE[child]
+
+    odom = inbox.latest("/odom")
+    assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_footprint")
+    scan = inbox.latest("/scan")
+    assert scan.header.frame_id == "base_scan"
+    assert len(scan.ranges) == 360
+    assert all(math.isinf(r) and r > 0 for r in scan.ranges)  # the empty world
+    joints = inbox.latest("/joint_states")
+    assert list(joints.name) == ["wheel_left_joint", "wheel_right_joint"]
+    assert "<robot" in inbox.latest("/robot_description").data
+    clock_ns = [c.clock.sec * 10**9 + c.clock.nanosec for c in inbox.got["/clock"]]
+    assert clock_ns == sorted(clock_ns)
+
+    code, out, _ = rosl.run("topic", "list", "-t")
+    assert code == 0
+    listed = dict(re.findall(r"^(\S+) \[(\S+)\]$", out, re.MULTILINE))
+    for topic, type_name in TOPICS.items():
+        assert listed.get(topic) == type_name, out
+
+    code, out, err = rosl.run("tf", "frames", "--dot", "-t", "1.5")
+    assert code == 0, err
+    edges = dict((c, p) for p, c in re.findall(r'^"([^"]+)" -> "([^"]+)"\[', out, re.MULTILINE))
+    for child, parent in TREE.items():
+        assert edges.get(child) == parent, out
+
+    # /cmd_vel from `rosl topic pub` drives it
+    start_x = odom_x(inbox)
+    code, _, err = rosl.run(
+        "topic", "pub", "-t", "5", "-r", "10", "/cmd_vel", "geometry_msgs/msg/Twist",
+        "{linear: {x: 0.2}}",
+    )  # fmt: skip
+    assert code == 0, err
+    assert inbox.spin_until(lambda: odom_x(inbox) > start_x + 0.05, 10.0), odom_x(inbox)
+
+    # NaN on the bus: one warning, the last good command stays, the sim keeps running
+    code, _, err = rosl.run(
+        "topic", "pub", "-t", "3", "-r", "10", "/cmd_vel", "geometry_msgs/msg/Twist",
+        "{linear: {x: .nan}, angular: {z: 0.0}}",
+    )  # fmt: skip
+    assert code == 0, err
+    assert sim.wait_for("non-finite", "err", timeout=10.0), sim.both()
+    moving_x = odom_x(inbox)
+    inbox.spin_until(lambda: odom_x(inbox) > moving_x + 0.05, 10.0)
+    latest = inbox.latest("/odom")
+    assert math.isfinite(latest.pose.pose.position.x)
+    assert latest.twist.twist.linear.x == pytest.approx(0.2)
+    assert sim.child.poll() is None
+
+    assert sim.interrupt() == 0, sim.both()
+    warnings = [line for line in sim.lines("err") if "WARN" in line]
+    assert len(warnings) == 1, sim.both()
+    assert "ignored a cmd_vel with non-finite values" in warnings[0]
+    assert "Traceback" not in sim.text("err")
+    assert any("non-finite values: 3 time(s)" in line for line in sim.lines("out")), sim.both()
+
+
+def test_rosl_sim_stops_after_its_duration_and_prints_a_summary(rosl: Rosl) -> None:
+    code, out, err = rosl.run(
+        "sim", "turtlebot3_world", "--real-time-factor", "20", "--duration", "1", "--headless",
+        timeout=30.0,
+    )  # fmt: skip
+    assert code == 0, err
+    assert re.search(r"simulated 1\.00 s of turtlebot3_world", out), out
+    assert re.search(r"burger: drove 0\.00 m, .* no collisions; ends at x=-2\.00 y=-0\.50", out)
