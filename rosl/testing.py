@@ -15,11 +15,11 @@ the recording against a golden bag kept in the repository::
 A mismatch fails with the differences ``rosl bag diff`` prints (``/odom #12
 pose.pose.position.x: 1.2345 vs 1.2501 (|d|=0.0156 > 0.001)``). After an intended change,
 rewrite the golden bags from the new runs with ``pytest --rosl-regenerate-golden`` (or
-``ROSL_REGENERATE_GOLDEN=1 pytest``), review and commit them. The command-line flag needs this
-module loaded as a plugin: ``pytest -p rosl.testing``, or ``pytest_plugins = ["rosl.testing"]``
-in the top-level ``conftest.py``. By default the comparison leaves out ``/rosout``,
-``/parameter_events``, ``/clock`` and service events, and ignores ``header.stamp`` fields at
-any depth — they change from run to run.
+``ROSL_REGENERATE_GOLDEN=1 pytest``), review and commit them. Installing rosl registers this
+module as a pytest plugin (the ``pytest11`` entry point ``rosl.testing``), so the flag needs no
+``-p rosl.testing`` (which, like ``pytest_plugins = ["rosl.testing"]``, still works). By
+default the comparison leaves out ``/rosout``, ``/parameter_events``, ``/clock`` and service
+events, and ignores ``header.stamp`` fields at any depth — they change from run to run.
 """
 
 from __future__ import annotations

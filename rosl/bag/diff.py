@@ -27,7 +27,6 @@ if TYPE_CHECKING:
 LIMIT = 20
 NS = 1_000_000_000
 _INDEX = re.compile(r"\[\d+\]")
-IDL_SEPARATOR = "=" * 80 + "\n"
 
 
 @dataclass(slots=True)
@@ -283,8 +282,6 @@ class _Decoder:
 
     def __init__(self) -> None:
         self._local: dict[str, bool] = {}
-        self._schema_store: Any = None
-        self._registered: set[str] = set()
 
     def decode(self, message: BagMessage) -> Any:
         from rosl.idl import registry
@@ -300,30 +297,14 @@ class _Decoder:
         return self._from_schema(message)
 
     def _from_schema(self, message: BagMessage) -> Any:
+        from rosl.idl import registry
+        from rosl.idl.errors import InterfaceError
+
         if not message.schema_text:
             raise BagError(f"type {message.type or '(unnamed)'} is unknown and has no schema")
         try:
-            store = self._store(message)
-            return store.deserialize_cdr(message.data, message.type)
-        except Exception as err:  # rosbags raises several kinds for bad schemas or bytes
-            raise BagError(f"{message.type}: {type(err).__name__}: {err}") from None
-
-    def _store(self, message: BagMessage) -> Any:
-        from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
-
-        if self._schema_store is None:
-            self._schema_store = get_typestore(Stores.EMPTY)
-        if message.type not in self._registered:
-            text = message.schema_text
-            if message.schema_encoding == "ros2idl":
-                types: dict[str, Any] = {}
-                parts = text.split(IDL_SEPARATOR)[1:] if text.startswith(IDL_SEPARATOR) else [text]
-                for part in parts:
-                    body = part.split("\n", 1)[1] if part.startswith("IDL: ") else part
-                    types.update(get_types_from_idl(body))
-            else:
-                types = dict(get_types_from_msg(text, message.type))
-            fresh = {k: v for k, v in types.items() if k not in self._schema_store.fielddefs}
-            self._schema_store.register(fresh)
-            self._registered.add(message.type)
-        return self._schema_store
+            return registry.store().deserialize_with_schema(
+                message.data, message.type, message.schema_encoding, message.schema_text
+            )
+        except InterfaceError as err:
+            raise BagError(str(err)) from None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import datetime
 from typing import TYPE_CHECKING, Any
 
-from rosl.bag.reader import bag_files, channels, has_summary
+from rosl.bag.reader import Channel, bag_files, channels, has_summary
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -24,6 +24,11 @@ def summary(target: Path) -> dict[str, Any]:
         for message in iter_file(path):
             times.append(message.log_time)
     start, end = (min(times), max(times)) if times else (0, 0)
+    for entry in (meta or {}).get("topics_with_message_count") or []:
+        listed = entry.get("topic_metadata") or {}
+        name = str(listed.get("name", ""))
+        if name and name not in found:  # subscribed, but nothing came: ROS 2 lists it (Count: 0)
+            found[name] = Channel(name, str(listed.get("type", "")), "", "")
     topics = [c for c in found.values() if not c.topic.endswith("/_service_event")]
     services = [c for c in found.values() if c.topic.endswith("/_service_event")]
     return {
@@ -82,7 +87,7 @@ def text(target: Path) -> str:
     lines += [
         row("Bag size:", _size(data["bag_size"])),
         row("Storage id:", "mcap"),
-        row("ROS Distro:", data["ros_distro"]),
+        row("ROS Distro:", data["ros_distro"] or "unknown"),  # as rosbag2 prints an unnamed one
         row("Duration:", f"{seconds}.{nanos:09d}s"),
         row("Start:", _stamp(data["start_ns"])),
         row("End:", _stamp(data["end_ns"])),

@@ -10,6 +10,7 @@ import yaml
 from rosl.bag.errors import BagError
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
     from pathlib import Path
 
 VERSION = 9
@@ -52,6 +53,16 @@ def qos_entry(words: dict[str, Any]) -> dict[str, Any]:
         "liveliness_lease_duration": dict(_FOREVER),
         "avoid_ros_namespace_conventions": False,
     }
+
+
+def offered_qos(channel_metadata: Mapping[str, str]) -> list[dict[str, Any]]:
+    """The QoS profiles an MCAP channel's ``offered_qos_profiles`` (a YAML text) lists."""
+    text = channel_metadata.get("offered_qos_profiles", "")
+    try:
+        profiles = yaml.safe_load(text) if text else []
+    except yaml.YAMLError:
+        return []
+    return [p for p in profiles if isinstance(p, dict)] if isinstance(profiles, list) else []
 
 
 def write(

@@ -13,15 +13,13 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import os
 import queue
-import select
-import sys
 import threading
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from rosl.bag.controls import HINTS, Keyboard, Timeline
 from rosl.bag.errors import BagError
 from rosl.bag.reader import BagMessage, iter_bag
 from rosl.bag.trim import Scan, SourceChannel, scan, unfinished_warning
@@ -36,14 +34,6 @@ if TYPE_CHECKING:
 
 NS = 1_000_000_000
 NODE = "rosbag2_player"
-HINTS = (
-    "Adding keyboard callbacks.",
-    "Press SPACE for Pause/Resume",
-    "Press CURSOR_RIGHT for Play Next Message",
-    "Press CURSOR_UP for Increase Rate 10%",
-    "Press CURSOR_DOWN for Decrease Rate 10%",
-)
-_KEYS = {b" ": "pause", b"\x1b[C": "next", b"\x1b[A": "faster", b"\x1b[B": "slower"}
 _PASS = object()  # end of one pass through the bag (more follow with --loop)
 _DONE = object()
 
@@ -97,37 +87,6 @@ def parse_remap(rules: list[str] | tuple[str, ...]) -> tuple[tuple[str, str], ..
     return tuple(pairs)
 
 
-class _Timeline:
-    """The playback clock: bag time that runs at ``rate`` and can pause, step and jump."""
-
-    def __init__(self, start_ns: int, rate: float) -> None:
-        self.rate = rate
-        self.paused = False
-        self._bag = start_ns
-        self._wall = time.monotonic_ns()
-
-    def now(self) -> int:
-        if self.paused:
-            return self._bag
-        return self._bag + int((time.monotonic_ns() - self._wall) * self.rate)
-
-    def jump(self, bag_ns: int) -> None:
-        self._bag, self._wall = bag_ns, time.monotonic_ns()
-
-    def set_paused(self, paused: bool) -> None:
-        self.jump(self.now())
-        self.paused = paused
-
-    def set_rate(self, rate: float) -> None:
-        self.jump(self.now())
-        self.rate = rate
-
-    def seconds_until(self, bag_ns: int) -> float:
-        if self.paused:
-            return float("inf")
-        return (bag_ns - self.now()) / self.rate / NS
-
-
 class _Outlet:
     """The publisher of one played topic (keeps history when it was transient-local)."""
 
@@ -151,51 +110,6 @@ class _Outlet:
 
         for seq, data in list(self.history or ()):
             self.writer.send(data, kind=Kind.REPLAY, address=(*target, 0), seq=seq)
-
-
-class _Keyboard:
-    """SPACE and the arrow keys, read from a terminal in cbreak mode (restored on exit)."""
-
-    def __init__(self, enabled: bool) -> None:
-        self.fd = sys.stdin.fileno() if enabled and sys.stdin.isatty() else -1
-        self._saved: Any = None
-
-    @property
-    def active(self) -> bool:
-        return self.fd >= 0
-
-    def __enter__(self) -> _Keyboard:
-        if self.active:
-            import termios
-            import tty
-
-            self._saved = termios.tcgetattr(self.fd)
-            tty.setcbreak(self.fd)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self._saved is not None:
-            import termios
-
-            termios.tcsetattr(self.fd, termios.TCSADRAIN, self._saved)
-            self._saved = None
-
-    def read(self, timeout: float) -> list[str]:
-        """Wait up to ``timeout`` for keys; return the commands typed."""
-        ready, _, _ = select.select([self.fd], [], [], max(0.0, timeout))
-        if not ready:
-            return []
-        data = os.read(self.fd, 64)
-        commands = []
-        while data:
-            for key, command in _KEYS.items():
-                if data.startswith(key):
-                    commands.append(command)
-                    data = data[len(key) :]
-                    break
-            else:
-                data = data[1:]
-        return commands
 
 
 def qos_words(channel: SourceChannel) -> dict[str, Any]:
@@ -245,7 +159,7 @@ class Player:
         Raises:
             BagError: the bag cannot be read.
         """
-        keys = _Keyboard(self.options.keyboard)
+        keys = Keyboard(self.options.keyboard)
         if self.options.start_paused and not keys.active:
             raise BagError("--start-paused needs the keyboard: stdin is not a terminal")
         found = scan(self.bag)
@@ -398,9 +312,9 @@ class Player:
 
     # --- playing -----------------------------------------------------------------------------
 
-    def _run(self, keys: _Keyboard, start: int, remap: dict[str, str]) -> None:
+    def _run(self, keys: Keyboard, start: int, remap: dict[str, str]) -> None:
         item = self._take(keys, None)  # the first message is read before the clock starts
-        timeline = _Timeline(start, self.options.rate)
+        timeline = Timeline(start, self.options.rate)
         timeline.paused = self.options.start_paused
         self.result.passes = 1
         self._tick(timeline, force=True)
@@ -418,7 +332,7 @@ class Player:
             item = self._take(keys, timeline)
         self.result.stopped = self._stop.is_set()
 
-    def _take(self, keys: _Keyboard, timeline: _Timeline | None) -> Any:
+    def _take(self, keys: Keyboard, timeline: Timeline | None) -> Any:
         """The next item read ahead (None once stopped)."""
         while not self._stop.is_set():
             try:
@@ -428,7 +342,7 @@ class Player:
                     self._service(keys, timeline, 0.0)
         return None
 
-    def _wait_for(self, bag_ns: int, keys: _Keyboard, timeline: _Timeline) -> bool:
+    def _wait_for(self, bag_ns: int, keys: Keyboard, timeline: Timeline) -> bool:
         """Wait until the playback clock reaches ``bag_ns`` (or → is pressed while paused)."""
         while not self._stop.is_set():
             remaining = timeline.seconds_until(bag_ns)
@@ -441,7 +355,7 @@ class Player:
             self._service(keys, timeline, min(remaining, 0.05))
         return False
 
-    def _service(self, keys: _Keyboard, timeline: _Timeline, timeout: float) -> None:
+    def _service(self, keys: Keyboard, timeline: Timeline, timeout: float) -> None:
         """Publish /clock when due; read keys (or sleep) for up to ``timeout``."""
         self._tick(timeline)
         if self._clock is not None:
@@ -460,7 +374,7 @@ class Player:
                 timeline.set_rate(timeline.rate * (1.1 if command == "faster" else 0.9))
                 self._log(f"[INFO] [{NODE}]: Set rate to {timeline.rate:g}")
 
-    def _tick(self, timeline: _Timeline, force: bool = False) -> None:
+    def _tick(self, timeline: Timeline, force: bool = False) -> None:
         if self._clock is None or self.options.clock_hz is None:
             return
         now = time.monotonic()

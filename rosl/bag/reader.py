@@ -31,6 +31,7 @@ class BagMessage:
     data: bytes
     schema_encoding: str = ""
     schema_text: str = ""
+    channel_metadata: dict[str, str] = field(default_factory=dict)  # offered_qos_profiles
 
 
 @dataclass(slots=True)
@@ -125,6 +126,7 @@ def _iter_indexed(handle: BinaryIO, topics: set[str] | None) -> Iterator[BagMess
             bytes(message.data),
             schema.encoding if schema else "",
             schema.data.decode(errors="replace") if schema else "",
+            channel.metadata,
         )
 
 
@@ -158,7 +160,7 @@ def iter_records(handle: BinaryIO, topics: set[str] | None = None) -> Iterator[B
                 channel.topic, schema.name if schema else "", record.log_time,
                 record.publish_time, record.sequence, bytes(record.data),
                 schema.encoding if schema else "",
-                schema.data.decode(errors="replace") if schema else "",
+                schema.data.decode(errors="replace") if schema else "", channel.metadata,
             )  # fmt: skip
 
 

@@ -5,23 +5,27 @@ sent (no re-serialisation), ``log_time`` = receive time, ``publish_time`` = send
 sequence counter per channel. Topic names and types come from discovery, so topics that
 appear later are picked up; a type this process cannot read from .msg files is asked of the
 publisher's process. Service requests and responses become ``<service>/_service_event``
-messages as ROS 2's service introspection writes them. Chunks go to disk (flushed and
-fsynced) at least once a second, so a killed recorder loses at most the last second;
-``rosl bag reindex`` repairs such a folder.
+messages as ROS 2's service introspection writes them. Schemas are read off the receiving
+thread (``schemas.py``), so log times stay receive times when a topic appears mid-stream.
+Chunks go to disk (flushed and fsynced) at least once a second, so a killed recorder loses at
+most the last second; ``rosl bag reindex`` repairs such a folder. As rosbag2 does, a file is
+split before the message that would make it longer than ``max_bag_duration`` (by log time)
+or once it has reached ``max_bag_size`` bytes (counted as messages are written).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import sys
-import threading
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 from rosl.bag import metadata
 from rosl.bag.errors import BagError
+from rosl.bag.schemas import PENDING_LIMIT_S, Schemas
 from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION, is_hidden
 
@@ -33,8 +37,8 @@ if TYPE_CHECKING:
     from rosl.node.participant import Participant
 
 FLUSH_EVERY_S = 1.0
-PENDING_LIMIT_S = 3.0
 PENDING_MAX = 20000
+MESSAGE_RECORD = 31  # bytes of an MCAP message record besides its data
 
 
 @dataclass(slots=True)
@@ -52,9 +56,19 @@ class _File:
     handle: BinaryIO
     writer: Any
     info: metadata.FileInfo
-    opened: float = field(default_factory=time.monotonic)
     schemas: dict[str, int] = field(default_factory=dict)
     channels: dict[str, int] = field(default_factory=dict)
+    position: int = 0  # where the handle was after the last chunk went out
+    unchunked: int = 0  # message bytes in the chunk still being built
+
+    def size(self) -> int:
+        """The file's size so far, the chunk being built counted uncompressed."""
+        return self.handle.tell() + self.unchunked
+
+    def chunk_written(self) -> None:
+        """Note that the chunk being built went to the handle (a flush)."""
+        self.position = self.handle.tell()
+        self.unchunked = 0
 
 
 class Recorder:
@@ -94,9 +108,8 @@ class Recorder:
         self._node_index = 0
         self._pending: list[Delivery] = []
         self._pending_since: dict[tuple[int, int], float] = {}
-        self._typedefs: dict[str, tuple[str, str, str]] = {}
-        self._asked: dict[str, float] = {}
-        self._lock = threading.Lock()
+        self._schemas: Schemas | None = None
+        self._failure: BagError | None = None  # the first write the disk refused
         self._last_flush = time.monotonic()
         self.dropped_unknown = 0
         self.skipped_types: set[str] = set()
@@ -124,7 +137,7 @@ class Recorder:
         except OSError as err:
             raise BagError(f"cannot record into '{self.folder}': {err.strerror}") from None
         self.participant = Participant(self.domain)
-        self.participant.discovery.handlers["typedef"] = self._on_typedef
+        self._schemas = Schemas(self.participant, self._log)
         self._node_index = self.participant.add_node(self._describe)
         if self.topics is None or self.services:
             self.participant.listen_all()
@@ -141,6 +154,8 @@ class Recorder:
     def step(self, timeout: float = 0.1) -> None:
         """Receive and write what arrives within ``timeout``; flush once a second."""
         assert self.participant is not None
+        assert self._schemas is not None
+        self._schemas.preload(self._wanted_types)
         self.participant.poll(timeout, sink=self._on_delivery)
         self._sync_graph()
         now = time.monotonic()
@@ -149,7 +164,6 @@ class Recorder:
         if now - self._last_flush >= FLUSH_EVERY_S:
             self._flush()
             self._last_flush = now
-            self._maybe_split(now)
 
     def record_at(
         self,
@@ -186,7 +200,11 @@ class Recorder:
             self._chunk_ns = now_ns
             wall = time.monotonic()
             if self._file is not None:
-                self._file.writer.flush()
+                try:
+                    self._file.writer.flush()
+                except OSError as err:
+                    raise self._failed(self._file, err) from None
+                self._file.chunk_written()
                 if wall - self._last_flush >= FLUSH_EVERY_S:
                     self._flush()
                     self._last_flush = wall
@@ -197,17 +215,33 @@ class Recorder:
             self.step(0.1)
 
     def close(self) -> None:
-        """Finish the MCAP file(s) with their index and write metadata.yaml (idempotent)."""
+        """Finish the MCAP file(s) with their index and write metadata.yaml (idempotent).
+
+        Raises:
+            BagError: the disk refused a write (the first such error, also when it came
+                before); the unfinished file is left for ``rosl bag reindex``.
+        """
         if self.stopped:
             return
         self.stopped = True
-        if self.participant is not None and not self.participant.closed and not self.sim_time:
-            self.participant.poll(0.0, sink=self._on_delivery)
-        if self._pending:
-            self._retry_pending(time.monotonic() + PENDING_LIMIT_S + 1)
-        self._close_file()
-        if self.participant is not None:
-            self.participant.close()
+        if self._schemas is not None:
+            self._schemas.stop()  # what is still held is read here
+        try:
+            if self._failure is None:
+                if (
+                    self.participant is not None
+                    and not self.participant.closed
+                    and not self.sim_time
+                ):
+                    self.participant.poll(0.0, sink=self._on_delivery)
+                if self._pending:
+                    self._retry_pending(time.monotonic() + PENDING_LIMIT_S + 1)
+            self._close_file()
+        finally:
+            if self.participant is not None:
+                self.participant.close()
+        if self._failure is not None:  # no metadata.yaml: reindex rebuilds it from the files
+            raise self._failure
         infos = [t.info for t in self._topics.values()]
         if self.sim_time:  # the same run gives the same metadata
             infos.sort(key=lambda info: info.name)
@@ -250,13 +284,20 @@ class Recorder:
         if current is None:
             return
         self._file = None
+        if self._failure is not None:  # the disk refused a write: the file stays unfinished
+            with contextlib.suppress(OSError):
+                current.handle.close()
+            return
         try:
             current.writer.finish()
             current.handle.flush()
             os.fsync(current.handle.fileno())
             current.handle.close()
         except OSError as err:
-            raise BagError(f"cannot finish {current.path}: {err.strerror}") from None
+            with contextlib.suppress(OSError):
+                current.handle.close()
+            self._failure = BagError(f"cannot finish {current.path}: {err.strerror}")
+            raise self._failure from None
 
     def _flush(self) -> None:
         current = self._file
@@ -266,17 +307,32 @@ class Recorder:
             current.writer.flush()
             os.fsync(current.handle.fileno())
         except OSError as err:
-            raise BagError(f"cannot write {current.path}: {err.strerror} (disk full?)") from None
+            raise self._failed(current, err) from None
+        current.chunk_written()
 
-    def _maybe_split(self, now: float) -> None:
-        current = self._file
-        if current is None or not current.info.count:
-            return
-        too_big = self.max_bag_size and current.handle.tell() >= self.max_bag_size
-        too_long = self.max_bag_duration and now - current.opened >= self.max_bag_duration
-        if too_big or too_long:
-            self._close_file()
-            self._open_file()
+    def _failed(self, current: _File, err: OSError) -> BagError:
+        """The error of a write the disk refused, kept: :meth:`close` raises it again."""
+        if self._failure is None:
+            self._failure = BagError(f"cannot write {current.path}: {err.strerror} (disk full?)")
+        return self._failure
+
+    def _split_before(self, current: _File, log_time: int) -> bool:
+        """Whether a message logged at ``log_time`` belongs in a new file (rosbag2's rule)."""
+        if not current.info.count:
+            return False
+        if self.max_bag_duration and (
+            log_time - current.info.start_ns > self.max_bag_duration * 1_000_000_000
+        ):
+            return True
+        if not self.max_bag_size or current.size() < self.max_bag_size:
+            return False
+        if self.compression and current.unchunked:  # compressed, the chunk may be smaller
+            try:
+                current.writer.flush()
+            except OSError as err:
+                raise self._failed(current, err) from None
+            current.chunk_written()
+        return current.size() >= self.max_bag_size
 
     # --- messages ----------------------------------------------------------------------------
 
@@ -349,20 +405,36 @@ class Recorder:
         from rosl.idl import registry
 
         topic = self._subscribe(name, event_type_name(service_type), qos={"depth": 10})
-        if topic is not None:
-            self._write(name, topic, delivery, registry.store().serialize(event))
+        if topic is None:
+            self._hold(delivery)
+            return
+        self._write(name, topic, delivery, registry.store().serialize(event))
 
     def _write(self, name: str, topic: _Topic, delivery: Delivery, data: bytes) -> None:
         current = self._file
         assert current is not None
-        channel_id = current.channels.get(name)
-        if channel_id is None:
-            channel_id = self._register(current, name, topic)
+        if (self.max_bag_duration or self.max_bag_size) and self._split_before(
+            current, delivery.received
+        ):
+            self._close_file()
+            self._open_file()
+            current = self._file
+            assert current is not None
+        try:
+            channel_id = current.channels.get(name)
+            if channel_id is None:
+                channel_id = self._register(current, name, topic)
+            current.writer.add_message(
+                channel_id=channel_id, log_time=delivery.received, data=data,
+                publish_time=delivery.stamp, sequence=topic.sequence + 1,
+            )  # fmt: skip
+        except OSError as err:  # a chunk went out and the disk refused it
+            raise self._failed(current, err) from None
         topic.sequence += 1
-        current.writer.add_message(
-            channel_id=channel_id, log_time=delivery.received, data=data,
-            publish_time=delivery.stamp, sequence=topic.sequence,
-        )  # fmt: skip
+        if self.max_bag_size:
+            current.unchunked += MESSAGE_RECORD + len(data)
+            if current.handle.tell() != current.position:  # the chunk went out with it
+                current.chunk_written()
         topic.info.count += 1
         info = current.info
         info.count += 1
@@ -397,7 +469,8 @@ class Recorder:
         existing = self._topics.get(name)
         if existing is not None:
             return existing
-        found = self._schema(type_name)
+        assert self._schemas is not None
+        found = self._schemas.get(type_name)
         if found is None:
             return None
         encoding, text, digest = found
@@ -414,9 +487,11 @@ class Recorder:
         from rosl.node.service_events import event_topic, event_type_name
 
         assert self.participant is not None
+        assert self._schemas is not None
         graph = self.participant.graph
-        if graph.generation == self._synced:
+        if graph.generation == self._synced and not self._schemas.arrived:
             return
+        self._schemas.arrived = False  # before looking: a schema arriving now is seen next time
         self._synced = graph.generation
         for _, endpoint in graph.endpoints(PUBLISHER):
             if endpoint.name not in self._topics and self._wanted(endpoint.name):
@@ -464,44 +539,23 @@ class Recorder:
         ]
         return sorted(entries, key=repr)
 
-    def _schema(self, type_name: str) -> tuple[str, str, str] | None:
-        from rosl.idl import registry
-        from rosl.idl.errors import InterfaceError
+    def _wanted_types(self) -> set[str]:  # the schemas thread
+        """The types of the graph's wanted topics (and services) not yet recorded."""
+        from rosl.node.service_events import event_topic, event_type_name
 
-        with self._lock:
-            if type_name in self._typedefs:
-                return self._typedefs[type_name]
-        try:
-            encoding, text = registry.schema(type_name)
-            found = (encoding, text, registry.store().type_hash(type_name))
-        except InterfaceError:
-            return self._ask(type_name)
-        with self._lock:
-            self._typedefs[type_name] = found
-        return found
-
-    def _ask(self, type_name: str) -> tuple[str, str, str] | None:
-        """Ask the publisher's process for a type this process cannot read."""
         assert self.participant is not None
-        now = time.monotonic()
-        asked = self._asked.setdefault(type_name, now)
-        if now - asked > PENDING_LIMIT_S:
-            self._log(f"[WARN] [rosl_recorder]: nobody described type {type_name}; recording "
-                      "its messages without a schema")  # fmt: skip
-            found = ("", "", "")
-            with self._lock:
-                self._typedefs[type_name] = found
-            return found
-        if asked == now:
-            self.participant.discovery.send({"op": "typedef_request", "type": type_name})
-        return None
-
-    def _on_typedef(self, message: dict[str, Any]) -> None:  # discovery thread
-        with self._lock:
-            self._typedefs.setdefault(
-                str(message["type"]),
-                (str(message["encoding"]), str(message["text"]), str(message.get("hash", ""))),
-            )
+        graph = self.participant.graph
+        types = {
+            endpoint.type
+            for _, endpoint in graph.endpoints(PUBLISHER)
+            if endpoint.name not in self._topics and self._wanted(endpoint.name)
+        }
+        if self.services:
+            for _, endpoint in graph.endpoints(SERVER):
+                name = event_topic(endpoint.name)
+                if name not in self._topics and not (self.exclude and self.exclude.search(name)):
+                    types.add(event_type_name(endpoint.type))
+        return types
 
     def _hold(self, delivery: Delivery) -> None:
         key = (delivery.topic, delivery.type)

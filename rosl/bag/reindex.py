@@ -1,8 +1,9 @@
 """``rosl bag reindex``: make a folder whole again after a crash.
 
 Each unfinished MCAP file (no footer: its recorder was killed) is read up to the last
-complete record and rewritten with its index and summary; then ``metadata.yaml`` is rebuilt
-from the files present. Finished files are left as they are.
+complete record and rewritten with its index and summary, its channels' metadata (the
+``offered_qos_profiles``) kept; then ``metadata.yaml`` is rebuilt from the files present, each
+topic with the QoS its channel carries. Finished files are left as they are.
 """
 
 from __future__ import annotations
@@ -38,8 +39,8 @@ def rewrite(path: Path) -> int:
                     else 0
                 )
             if message.topic not in channels:
-                channels[message.topic] = writer.register_channel(
-                    message.topic, "cdr", schemas[message.type], {}
+                channels[message.topic] = writer.register_channel(  # offered QoS kept
+                    message.topic, "cdr", schemas[message.type], dict(message.channel_metadata)
                 )
             writer.add_message(
                 channels[message.topic], message.log_time, message.data, message.publish_time,
@@ -88,8 +89,11 @@ def reindex(folder: Path) -> list[str]:
             topic = topics.get(message.topic)
             if topic is None:
                 old = previous.get(message.topic, {})
+                # the QoS the file's channel carries: readers (rosbags) match the topics of
+                # metadata.yaml with the channels by name, type and QoS
                 topic = topics[message.topic] = metadata.TopicInfo(
-                    message.topic, message.type, qos=list(old.get("offered_qos_profiles") or []),
+                    message.topic, message.type,
+                    qos=metadata.offered_qos(message.channel_metadata),
                     type_hash=old.get("type_description_hash") or _hash(message.type),
                 )  # fmt: skip
             topic.count += 1

@@ -41,14 +41,7 @@ class SourceChannel:
 
     def offered_qos(self) -> list[dict[str, Any]]:
         """The ``offered_qos_profiles`` the recorder wrote in the channel's metadata."""
-        import yaml
-
-        text = self.metadata.get("offered_qos_profiles", "")
-        try:
-            profiles = yaml.safe_load(text) if text else []
-        except yaml.YAMLError:
-            return []
-        return [p for p in profiles if isinstance(p, dict)] if isinstance(profiles, list) else []
+        return metadata.offered_qos(self.metadata)
 
 
 @dataclass(slots=True)

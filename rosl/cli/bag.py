@@ -148,7 +148,7 @@ def play(bag: Path, **options: Any) -> None:
     player = Player(bag, PlayOptions(
         rate=options["rate"], loop=options["loop"], clock_hz=options["clock"],
         topics=options["topics"], start_offset=options["start_offset"],
-        remap=parse_remap(_flat(options["remap"])), read_ahead=options["read_ahead_queue_size"],
+        remap=parse_remap(list(options["remap"])), read_ahead=options["read_ahead_queue_size"],
         domain=options["domain_id"],
         keyboard=not options["disable_keyboard_controls"] and sys.stdin.isatty(),
         start_paused=options["start_paused"],
@@ -234,11 +234,3 @@ def convert(source: Path, output: Path, compression_format: str | None) -> None:
     for line in result.warnings:
         render.warn(line)
     render.lines([result.summary()])
-
-
-def _flat(values: Any) -> list[str]:
-    """Flatten a GreedyOption's values (an option with two names nests them one level more)."""
-    flat: list[str] = []
-    for item in values or ():
-        flat.extend(_flat(item) if isinstance(item, tuple) else [item])
-    return flat

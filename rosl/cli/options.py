@@ -16,10 +16,12 @@ class GreedyOption(click.Option):
     def add_to_parser(self, parser: Any, ctx: click.Context) -> None:
         """Register the option, then make its parser consume the values that follow it."""
         super().add_to_parser(parser, ctx)
+        patched: list[Any] = []
         for name in self.opts:
             option = parser._long_opt.get(name) or parser._short_opt.get(name)
-            if option is None:
-                continue
+            if option is None or any(option is done for done in patched):
+                continue  # one parser option serves all the names (-m and --remap)
+            patched.append(option)
             original = option.process
 
             def process(value: Any, state: Any, _original: Any = original) -> None:

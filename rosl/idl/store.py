@@ -63,6 +63,7 @@ class Store:
         self._typestore = Typestore()
         self._lock = threading.Lock()
         self._checked: set[str] = set()
+        self._schemas: dict[tuple[str, str, str], Typestore] = {}  # a recording's definitions
 
     def __contains__(self, type_name: str) -> bool:
         return type_name in self._typestore.fielddefs
@@ -101,6 +102,35 @@ class Store:
         except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
             raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
 
+    def deserialize_with_schema(
+        self, data: bytes | bytearray | memoryview, type_name: str, encoding: str, text: str
+    ) -> Any:
+        """Decode CDR bytes with the definition a recording carries (its MCAP schema).
+
+        ``encoding`` is ``ros2msg`` (the type's text, then each type it uses after a line of 80
+        ``=`` and ``MSG: pkg/msg/Name``) or ``ros2idl`` (sections headed ``IDL: pkg/...``). Each
+        distinct schema gets a type store of its own, apart from this process's types, so two
+        recordings may define one name differently. The result is a rosbags message object
+        (fields as attributes), not one of this process's classes.
+
+        Raises:
+            InterfaceError: the schema cannot be read, or the bytes are not that type.
+        """
+        key = (type_name, encoding, text)
+        with self._lock:
+            typestore = self._schemas.get(key)
+        if typestore is None:
+            typestore = _schema_typestore(type_name, encoding, text)
+            with self._lock:
+                typestore = self._schemas.setdefault(key, typestore)
+        try:
+            return typestore.deserialize_cdr(data, type_name)
+        except Exception as err:  # rosbags raises several kinds for bytes that do not fit
+            raise InterfaceError(
+                f"cannot decode {type_name} ({len(data)} bytes) with its schema: "
+                f"{type(err).__name__}: {err}"
+            ) from err
+
     def type_hash(self, type_name: str) -> str:
         """Return the RIHS01 hash ROS 2 (Iron and later) gives this type."""
         return self._typestore.hash_rihs01(type_name)
@@ -108,3 +138,35 @@ class Store:
     def fielddefs(self, type_name: str) -> Any:
         """Return rosbags' (constants, fields) entry for a registered type."""
         return self._typestore.fielddefs[type_name]
+
+
+_SECTION = "=" * 80 + "\n"
+
+
+def _schema_typestore(type_name: str, encoding: str, text: str) -> Typestore:
+    """A type store holding the types one MCAP schema defines."""
+    from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
+
+    try:
+        types: dict[str, Any] = {}
+        if encoding == "ros2idl":
+            parts = text.split(_SECTION)[1:] if text.startswith(_SECTION) else [text]
+            for part in parts:
+                types.update(
+                    get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
+                )
+        elif encoding == "ros2msg":
+            types.update(get_types_from_msg(text, type_name))
+        else:
+            raise InterfaceError(
+                f"{type_name}: schema encoding '{encoding}' is not ros2msg or ros2idl"
+            )
+        typestore = get_typestore(Stores.EMPTY)
+        typestore.register(types)
+    except InterfaceError:
+        raise
+    except Exception as err:  # rosbags' parsers raise several kinds for a bad definition
+        raise InterfaceError(
+            f"cannot read the {encoding} schema of {type_name}: {type(err).__name__}: {err}"
+        ) from None
+    return typestore

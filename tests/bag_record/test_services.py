@@ -1,0 +1,119 @@
+"""``--include-services``: service traffic as ROS 2 (Jazzy) service introspection events.
+
+A server of /add_two_ints and a client making two calls run while ``rosl bag record -a
+--include-services`` records (and, alongside, ``rosl bag record -a`` without the flag).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from rosl.idl.idl_text import full_idl
+from tests.bag_record import support
+
+if TYPE_CHECKING:
+    from tests.bag_record.conftest import ServiceBag
+
+EVENT_TOPIC = "/add_two_ints/_service_event"
+EVENT_TYPE = "example_interfaces/srv/AddTwoInts_Event"
+REQUEST_SENT, RESPONSE_SENT = 0, 2
+
+
+def events(bag: ServiceBag) -> list[support.Read]:
+    return support.by_topic(support.read_anyreader(bag.folder))[EVENT_TOPIC]
+
+
+def test_the_client_made_its_calls(service_bag: ServiceBag) -> None:
+    assert [(c["a"], c["b"], c["sum"]) for c in service_bag.calls] == [(2, 3, 5), (-10, 4, -6)]
+
+
+def test_service_events_are_recorded_on_the_service_event_topic(service_bag: ServiceBag) -> None:
+    entries = {
+        e["topic_metadata"]["name"]: e
+        for e in support.metadata(service_bag.folder)["topics_with_message_count"]
+    }
+    assert entries[EVENT_TOPIC]["topic_metadata"]["type"] == EVENT_TYPE
+    assert entries[EVENT_TOPIC]["message_count"] == 4
+    assert entries[EVENT_TOPIC]["topic_metadata"]["serialization_format"] == "cdr"
+
+
+def test_event_schemas_are_ros2idl_of_the_event_type(service_bag: ServiceBag) -> None:
+    schemas = {k: v for f in support.read_mcap(service_bag.folder) for k, v in f.schemas.items()}
+    encoding, text = schemas[EVENT_TYPE]
+    assert encoding == "ros2idl"
+    assert text == full_idl(EVENT_TYPE)
+    assert "IDL: service_msgs/msg/ServiceEventInfo\n" in text
+    meta = {
+        e["topic_metadata"]["name"]: e["topic_metadata"]
+        for e in support.metadata(service_bag.folder)["topics_with_message_count"]
+    }
+    assert meta[EVENT_TOPIC]["type_description_hash"] == support.rihs01(EVENT_TYPE, "ros2idl", text)
+
+
+def test_requests_and_responses_are_sent_events_carrying_the_values(
+    service_bag: ServiceBag,
+) -> None:
+    found = [m.fields for m in events(service_bag)]
+    requests = [e for e in found if e["info"]["event_type"] == REQUEST_SENT]
+    responses = [e for e in found if e["info"]["event_type"] == RESPONSE_SENT]
+    assert len(requests) == 2
+    assert len(responses) == 2
+    assert [(e["request"][0]["a"], e["request"][0]["b"]) for e in requests] == [(2, 3), (-10, 4)]
+    assert all(e["response"] == [] for e in requests)
+    assert [e["response"][0]["sum"] for e in responses] == [5, -6]
+    assert all(e["request"] == [] for e in responses)
+
+
+def test_client_gid_and_sequence_number_pair_each_request_with_its_response(
+    service_bag: ServiceBag,
+) -> None:
+    found = [m.fields for m in events(service_bag)]
+    key = {
+        (tuple(e["info"]["client_gid"]), e["info"]["sequence_number"]): e for e in found
+        if e["info"]["event_type"] == REQUEST_SENT
+    }  # fmt: skip
+    assert len(key) == 2
+    gids = {gid for gid, _ in key}
+    assert len(gids) == 1, "one client made both calls"
+    assert any(next(iter(gids))), "the client GID is not all zeros"
+    for response in (e for e in found if e["info"]["event_type"] == RESPONSE_SENT):
+        pair = (tuple(response["info"]["client_gid"]), response["info"]["sequence_number"])
+        request = key[pair]["request"][0]
+        assert response["response"][0]["sum"] == request["a"] + request["b"]
+
+
+def test_event_stamps_fall_within_each_call(service_bag: ServiceBag) -> None:
+    found = [m.fields for m in events(service_bag)]
+    for call, event_type in (
+        (c, t) for c in service_bag.calls for t in (REQUEST_SENT, RESPONSE_SENT)
+    ):
+        matching = [
+            e for e in found
+            if e["info"]["event_type"] == event_type
+            and (e["request"] or e["response"])[0] in (
+                {"a": call["a"], "b": call["b"]}, {"sum": call["sum"]},
+            )
+        ]  # fmt: skip
+        assert len(matching) == 1, (call, event_type)
+        stamp = matching[0]["info"]["stamp"]
+        ns = stamp["sec"] * 1_000_000_000 + stamp["nanosec"]
+        assert call["before"] <= ns <= call["after"], (call, event_type, ns)
+
+
+def test_every_reader_reads_the_service_events(service_bag: ServiceBag) -> None:
+    rosbag2 = support.by_topic(support.read_rosbag2(service_bag.folder))[EVENT_TOPIC]
+    mcap = support.by_topic([m for f in support.read_mcap(service_bag.folder) for m in f.messages])[
+        EVENT_TOPIC
+    ]
+    anyreader = events(service_bag)
+    assert [m.fields for m in rosbag2] == [m.fields for m in anyreader]
+    assert [m.fields for m in mcap] == [m.fields for m in anyreader]
+    assert [m.sequence for m in mcap] == [1, 2, 3, 4]
+
+
+def test_without_include_services_no_service_events_are_recorded(
+    service_bag: ServiceBag,
+) -> None:
+    counts = support.topic_counts(service_bag.plain)
+    assert counts["/numbers"] == 5
+    assert not [t for t in counts if t.endswith("/_service_event")], counts
