@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from rosl.cli import render
+from rosl.cli.options import domain_option, export_domain
 from rosl.launch import loader, runner
 
 
@@ -39,10 +40,17 @@ from rosl.launch import loader, runner
     metavar="[DIR]",
     help="Record everything on the bus while the launch runs (rosbag2 folder)",
 )
+@domain_option
 def command(
-    target: str, rest: tuple[str, ...], show_args: bool, print_plan: bool, record: str | None
+    target: str,
+    rest: tuple[str, ...],
+    show_args: bool,
+    print_plan: bool,
+    record: str | None,
+    domain_id: int | None,
 ) -> int:
     """Run a launch file: `rosl launch tutorial_pkg my_launch.py` or `rosl launch ./x.launch.py`."""
+    export_domain(domain_id)
     args = list(rest)
     if Path(target).is_file() or (
         target.endswith((".py", ".yaml", ".yml", ".xml")) and "/" in target

@@ -49,3 +49,14 @@ def domain_option(command: Any) -> Any:
         default=None,
         help="Domain to use instead of ROSL_DOMAIN_ID / ROS_DOMAIN_ID.",
     )(command)
+
+
+def export_domain(domain_id: int | None) -> None:
+    """Make ``--domain-id`` the domain of this process and of every process it starts."""
+    if domain_id is None:
+        return
+    import os
+
+    from rosl.bus.multicast import domain_from_env
+
+    os.environ["ROSL_DOMAIN_ID"] = str(domain_from_env(domain_id))

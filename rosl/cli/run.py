@@ -8,6 +8,7 @@ import sys
 
 import click
 
+from rosl.cli.options import domain_option, export_domain
 from rosl.pkg.executables import command_line, find_executable
 
 
@@ -15,13 +16,19 @@ from rosl.pkg.executables import command_line, find_executable
     "run", context_settings={"ignore_unknown_options": True, "allow_interspersed_args": False}
 )
 @click.option("--prefix", default=None, help="Prefix command, e.g. 'python -m cProfile'")
+@domain_option
 @click.argument("package_name")
 @click.argument("executable_name")
 @click.argument("argv", nargs=-1, type=click.UNPROCESSED)
 def command(
-    prefix: str | None, package_name: str, executable_name: str, argv: tuple[str, ...]
+    prefix: str | None,
+    domain_id: int | None,
+    package_name: str,
+    executable_name: str,
+    argv: tuple[str, ...],
 ) -> None:
     """Run a package specific executable (no build, no sourcing)."""
+    export_domain(domain_id)
     executable = find_executable(package_name, executable_name)
     cmd = [*(shlex.split(prefix) if prefix else []), *command_line(executable, list(argv))]
     sys.stdout.flush()

@@ -23,6 +23,8 @@ class EndpointRecord:
         endpoint: the endpoint's number within its process.
         qos: QoS words (reliability, durability, history, depth, ...).
         stats: counters: ``sent`` for writers; ``received`` and ``lost`` for readers.
+        digest: a fingerprint of the type's definition as the endpoint's process reads it
+            (empty when unknown): two endpoints of one type name may still disagree on fields.
     """
 
     kind: str
@@ -31,6 +33,7 @@ class EndpointRecord:
     endpoint: int
     qos: dict[str, Any] = field(default_factory=dict, hash=False, compare=False)
     stats: dict[str, int] = field(default_factory=dict, hash=False, compare=False)
+    digest: str = field(default="", hash=False, compare=False)
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,7 +95,8 @@ def to_json(record: ProcessRecord) -> dict[str, Any]:
                 "namespace": n.namespace,
                 "index": n.index,
                 "endpoints": [
-                    [e.kind, e.name, e.type, e.endpoint, e.qos, e.stats] for e in n.endpoints
+                    [e.kind, e.name, e.type, e.endpoint, e.qos, e.stats, e.digest]
+                    for e in n.endpoints
                 ],
             }
             for n in record.nodes
@@ -110,8 +114,10 @@ def from_json(data: dict[str, Any], seen: float) -> ProcessRecord:
             process=sender,
             index=int(n["index"]),
             endpoints=tuple(
-                EndpointRecord(str(k), str(name), str(t), int(e), dict(q), dict(s))
-                for k, name, t, e, q, s in n["endpoints"]
+                EndpointRecord(
+                    str(k), str(name), str(t), int(e), dict(q), dict(s), str(d[0]) if d else ""
+                )
+                for k, name, t, e, q, s, *d in n["endpoints"]
             ),
         )
         for n in data["nodes"]

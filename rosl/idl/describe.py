@@ -9,6 +9,7 @@ kept at the top level, dropped in nested definitions (``all_comments`` keeps the
 from __future__ import annotations
 
 from rosl.idl import registry
+from rosl.idl.errors import InterfaceError
 from rosl.idl.names import TypeName, parse_type_name
 from rosl.idl.parser import ServiceSpec, split_comment
 
@@ -21,7 +22,7 @@ def show(type_name: str, *, all_comments: bool = False, no_comments: bool = Fals
     """
     name = _interface_name(type_name)
     lines: list[str] = []
-    _show(str(name), not no_comments, all_comments, 0, lines)
+    _show(str(name), not no_comments, all_comments, [], lines)
     return "".join(line + "\n" for line in lines)
 
 
@@ -35,8 +36,12 @@ def _interface_name(type_name: str) -> TypeName:
 
 
 def _show(
-    type_name: str, comments: bool, nested_comments: bool, level: int, out: list[str]
+    type_name: str, comments: bool, nested_comments: bool, parents: list[str], out: list[str]
 ) -> None:
+    if type_name in parents:
+        cycle = " -> ".join([*parents[parents.index(type_name) :], type_name])
+        raise InterfaceError(f"recursive message definition: {cycle}")
+    level = len(parents)
     spec = registry.load_spec(type_name)
     halves = [spec.request, spec.response] if isinstance(spec, ServiceSpec) else [spec]
     resolved = {h.type_name: registry.resolve(h) for h in halves}
@@ -56,7 +61,7 @@ def _show(
             text = code.strip()
         out.append("\t" * level + text if text else "")
         if number in nested_at:
-            _show(nested_at[number], nested_comments, nested_comments, level + 1, out)
+            _show(nested_at[number], nested_comments, nested_comments, [*parents, type_name], out)
 
 
 def prototype(type_name: str) -> str:

@@ -340,6 +340,18 @@ def msgdef_text(type_name: str) -> str:
     return text_of(key)
 
 
+def digest(type_name: str) -> str:
+    """A short fingerprint of a loaded type's definition (the start of its RIHS01 hash).
+
+    Discovery carries it with each endpoint, so a subscription can tell a publisher whose
+    .msg file says something else under the same type name. Empty when it cannot be made.
+    """
+    try:
+        return store().type_hash(type_name)[7:23]
+    except Exception:  # rosbags raises several kinds for a type it cannot hash
+        return ""
+
+
 def loaded(type_name: str) -> bool:
     """Whether a type's class was built in this process (so its definition is at hand)."""
     return type_name in _classes

@@ -146,7 +146,10 @@ class Node(ExecuteProcess):
                     f"not {type(entry).__name__}"
                 )
         args: list[str] = []
-        if values and context.supervisor is not None:
+        if values and context.supervisor is not None and context.supervisor.dry_run:
+            for key, value in values.items():  # --print: a command line that runs as printed
+                args += ["-p", f"{key}:={_yaml_value(value)}"]
+        elif values and context.supervisor is not None:
             args += [
                 "--params-file",
                 str(context.supervisor.parameter_file(self._label(context), values)),
@@ -264,3 +267,15 @@ class SetRemap(Action):
     def execute(self, context: LaunchContext) -> None:
         """Record it on the current scope."""
         context.scope.remappings.append((self.src, self.dst))
+
+
+def _yaml_value(value: Any) -> str:
+    """A parameter value as ``-p name:=VALUE`` text that YAML reads back as the same value."""
+    import yaml
+
+    return (
+        str(yaml.safe_dump(value, default_flow_style=True, width=1 << 30))
+        .strip()
+        .removesuffix("\n...")
+        .strip()
+    )

@@ -42,6 +42,21 @@ if TYPE_CHECKING:
 
 _TOKEN = re.compile(r"\$\(([a-z_-]+)(?:\s+([^)]*))?\)")
 LINE = "__line__"
+_GUARDS = {"if", "unless"}
+_KEYS = {  # the keys rosl reads for each entry; ROS 2 refuses unknown attributes too
+    "arg": {"name", "default", "description"},
+    "let": {"name", "value"},
+    "set_env": {"name", "value"},
+    "log": {"message"},
+    "push_ros_namespace": {"namespace"},
+    "group": {"children", "scoped"},
+    "include": {"file", "arg"},
+    "executable": {"cmd", "name", "output"},
+    "node": {
+        "pkg", "exec", "name", "namespace", "output", "param", "remap", "args", "ros_args",
+        "respawn",
+    },
+}  # fmt: skip
 
 
 class _Loader(yaml.SafeLoader):
@@ -125,8 +140,21 @@ class _Reader:
                     f"unsupported launch entry '{kind}' (rosl reads: arg, let, node, executable, "
                     "include, group, push_ros_namespace, set_env, log)",
                 )
+            self.keys(entry, _KEYS[kind.replace("-", "_")] | _GUARDS, where, kind)
             out.append(method(item[kind], where))
         return out
+
+    def keys(self, entry: dict[str, Any], allowed: set[str], line: int, what: str) -> None:
+        """Refuse a key rosl does not read (a typo would otherwise be ignored)."""
+        from rosl.idl.names import did_you_mean
+
+        for key in entry:
+            if key != LINE and key not in allowed:
+                raise self.fail(
+                    line,
+                    f"unknown attribute '{key}' in '{what}'{did_you_mean(str(key), allowed)} "
+                    f"(rosl reads: {', '.join(sorted(allowed))})",
+                )
 
     def need(self, entry: Any, key: str, line: int) -> Any:
         if not isinstance(entry, dict) or key not in entry:

@@ -32,6 +32,7 @@ class Publisher:
         )
         participant.writers.append(self._writer)
         self._store = registry.store()
+        self.digest = registry.digest(self.type_name)
         self._history: collections.deque[tuple[int, int, bytes]] | None = (
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
         )
@@ -78,7 +79,7 @@ class Publisher:
         """This publisher as discovery announces it."""
         return EndpointRecord(
             PUBLISHER, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
-            {"sent": self._writer.sent},
+            {"sent": self._writer.sent}, self.digest,
         )  # fmt: skip
 
     def destroy(self) -> None:

@@ -154,9 +154,19 @@ def parse_value(text: str) -> Any:
 
 
 def _remap(text: str) -> Remap:
+    from rosl.node.errors import InvalidNameError
+    from rosl.node.names import validate_namespace, validate_node_name
+
     node, source, target = _split_rule(text, "-r")
     if not target:
         raise RosArgsError(f"--ros-args -r '{text}': nothing after ':='")
+    try:
+        if source in ("__node", "__name"):
+            validate_node_name(target)
+        elif source == "__ns":
+            validate_namespace(target if target.startswith("/") else "/" + target)
+    except InvalidNameError as err:
+        raise RosArgsError(f"--ros-args -r '{text}': {err}") from None
     return Remap(source, target, node)
 
 
@@ -178,10 +188,13 @@ def params_from_file(path: Path, node_fqn: str) -> dict[str, Any]:
     """
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
-    except (OSError, yaml.YAMLError) as err:
+    except OSError as err:
+        raise RosArgsError(f"{path}: cannot read: {err.strerror}") from None
+    except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
-        raise RosArgsError(f"{where}: not a readable YAML parameter file ({err})") from None
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(path)
+        problem = getattr(err, "problem", None) or "not YAML"
+        raise RosArgsError(f"{where}: not a valid YAML parameter file: {problem}") from None
     if not isinstance(data, dict):
         raise RosArgsError(f"{path}: a parameter file maps node names to ros__parameters")
     matches: list[tuple[int, dict[str, Any]]] = []

@@ -1,8 +1,10 @@
 """Subscriptions: check the type hash, decode, call back — on the thread that read the socket.
 
 A message whose type differs from the subscription's is dropped undecoded and reported once
-(never mis-decoded). Transient-local subscriptions ask publishers for their history when
-created. Callbacks taking two arguments also get the message info (timestamps, sequence).
+(never mis-decoded); so is one from a publisher whose definition of the same type name differs
+(discovery carries each endpoint's definition digest: an edited .msg file while old nodes
+run). Transient-local subscriptions ask publishers for their history when created. Callbacks
+taking two arguments also get the message info (timestamps, sequence).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ if TYPE_CHECKING:
 
 
 _REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster than enums
+LOSS_REPORT_EVERY_NS = 5_000_000_000
 
 
 def _wants_info(callback: Callable[..., Any]) -> bool:
@@ -66,6 +69,11 @@ class Subscription:
         self._type_hash = type_hash(self.type_name)
         self._with_info = _wants_info(callback)
         self._store = registry.store()
+        self.digest = registry.digest(self.type_name)
+        self._peers: dict[tuple[int, int], bool] = {}  # (process, endpoint) -> same definition
+        self._streams = participant.reader.streams  # sequence bookkeeping per publisher
+        self._lost_told = 0  # the loss already reported in the log
+        self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
         self.received = 0
         self.mismatched = 0
@@ -104,10 +112,20 @@ class Subscription:
             self._replayed.append(key)
         elif delivery.kind != _DATA:
             return
-        elif self.qos_profile.keeps_history:
-            self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
+        else:
+            if self.qos_profile.keeps_history:
+                self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
+            stream = self._streams.get((delivery.sender, delivery.endpoint))
+            if stream is not None and stream.lost and delivery.received >= self._lost_told_at:
+                self._tell_loss(delivery)
         if delivery.type != self._type_hash:
             self._mismatch(delivery)
+            return
+        agrees = self._peers.get((delivery.sender, delivery.endpoint))
+        if agrees is None:
+            agrees = self._same_definition(delivery)
+        if not agrees:
+            self.mismatched += 1
             return
         if self.raw:
             message: Any = bytes(delivery.payload)
@@ -148,6 +166,34 @@ class Subscription:
             f"type{who}; dropped without decoding (publisher and subscriber types must match)"
         )
 
+    def _tell_loss(self, delivery: Delivery) -> None:
+        """Log messages lost on this topic since the last report (at most every few seconds)."""
+        lost = self.lost
+        self._lost_told_at = delivery.received + LOSS_REPORT_EVERY_NS
+        if lost <= self._lost_told:
+            return
+        self.node.get_logger().warn(
+            f"lost {lost - self._lost_told} message(s) on {self.topic} (sequence gaps: the "
+            "process fell behind the publisher or its socket buffer overflowed)"
+        )
+        self._lost_told = lost
+
+    def _same_definition(self, delivery: Delivery) -> bool:
+        """Whether the sending publisher reads the type as this process does (graph-checked)."""
+        for node, endpoint in self.node.participant.graph.endpoints(PUBLISHER, self.topic):
+            if node.process != delivery.sender or endpoint.endpoint != delivery.endpoint:
+                continue
+            agrees = not endpoint.digest or not self.digest or endpoint.digest == self.digest
+            self._peers[(delivery.sender, delivery.endpoint)] = agrees
+            if not agrees:
+                self.node.get_logger().warn(
+                    f"subscription on {self.topic} expects {self.type_name} as this process's "
+                    f".msg files define it, but {node.fqn} publishes another definition of it "
+                    "(one of the two .msg files changed); dropped without decoding"
+                )
+            return agrees
+        return True  # not announced yet: nothing to compare with
+
     @property
     def lost(self) -> int:
         """Messages lost on this topic (sequence gaps seen by this process)."""
@@ -158,6 +204,7 @@ class Subscription:
         return EndpointRecord(
             SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
             {"received": self.received, "lost": self.lost, "mismatched": self.mismatched},
+            self.digest,
         )  # fmt: skip
 
     def close(self) -> None:

@@ -399,3 +399,27 @@ def test_a_reference_to_a_missing_type_names_the_package_folder_searched(
 
 def test_proto_of_an_unknown_type_is_one_line(rosl: Callable[..., Result]) -> None:
     assert_user_error(rosl("interface", "proto", "std_msgs/msg/Strin"), "did you mean 'String'")
+
+
+@pytest.mark.parametrize(
+    ("files", "shown", "cycle"),
+    [
+        ({"msg/Rec.msg": "Rec r\n"}, "loops/msg/Rec", "loops/msg/Rec -> loops/msg/Rec"),
+        (
+            {"msg/A.msg": "int32 x\nB b\n", "msg/B.msg": "A a\n"},
+            "loops/msg/A",
+            "loops/msg/A -> loops/msg/B -> loops/msg/A",
+        ),
+    ],
+    ids=["self", "mutual"],
+)
+def test_interface_show_of_a_recursive_message_names_the_cycle(
+    rosl: Callable[..., Result],
+    make_package: Callable[..., Path],
+    files: dict[str, str],
+    shown: str,
+    cycle: str,
+) -> None:
+    make_package("loops", files)
+    line = assert_user_error(rosl("interface", "show", shown), "recursive message definition")
+    assert line == f"recursive message definition: {cycle}"

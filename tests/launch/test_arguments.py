@@ -267,7 +267,8 @@ def test_print_shows_command_lines_remaps_and_parameters_without_starting_anythi
     assert "-r __node:=talker" in talker
     assert "-r __ns:=/demo" in talker
     assert "-r my_data:=/elsewhere" in talker
-    assert "--params-file " in talker
+    assert " -p rate:=2.0" in talker  # typed as a user would: it runs as printed
+    assert "--params-file" not in talker  # no file that --print did not write
     assert "    param: rate = 2.0" in lines
     assert "    remap: my_data -> /elsewhere" in lines
     assert any(line.startswith("[toucher-2] touch ") for line in lines), out

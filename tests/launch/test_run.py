@@ -137,3 +137,55 @@ def test_run_of_an_unknown_package_names_it_and_suggests_the_closest(rosl: Rosl)
     assert out == ""
     line = one_error_line(err)
     assert line.startswith("package 'tutorial_pk' not found (did you mean 'tutorial_pkg'?)"), line
+
+
+@pytest.mark.parametrize(
+    ("ros_args", "message"),
+    [
+        (["--params-file", "nosuch.yaml"], "timer_node: --params-file nosuch.yaml: no such file"),
+        (["--log-level", "bogus"], "timer_node: --log-level 'bogus': use one of debug, info, warn"),
+        (["-r", "__node:=1bad"], "timer_node: --ros-args -r '__node:=1bad': invalid node name"),
+        (["-p", "timer_period_s=0.2"], "timer_node: --ros-args -p 'timer_period_s=0.2': expected"),
+        (["--foo"], "timer_node: unknown ROS argument '--foo'"),
+    ],
+    ids=["params-file", "log-level", "node-name", "param-rule", "unknown-flag"],
+)
+def test_run_reports_a_ros_args_mistake_in_one_line(
+    rosl: Rosl, ros_args: list[str], message: str
+) -> None:
+    code, out, err = rosl.run("run", "tutorial_pkg", "timer_node", "--ros-args", *ros_args)
+
+    assert code == 1
+    assert out == ""
+    assert one_error_line(err).startswith(message)
+
+
+def test_run_names_the_executables_line_for_a_parameter_of_the_wrong_type(rosl: Rosl) -> None:
+    code, _, err = rosl.run(
+        "run", "tutorial_pkg", "timer_node", "--ros-args", "-p", "timer_period_s:=abc"
+    )
+
+    assert code == 1
+    line = one_error_line(err)
+    assert line.startswith("timer_node: ")
+    assert "tutorial_pkg/timer_node.py:" in line  # where the code declares it
+    assert "Wrong parameter type, parameter {timer_period_s} is of type {double}" in line
+
+
+def test_run_reports_a_domain_out_of_range_in_one_line(
+    rosl: Rosl, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROSL_DOMAIN_ID", "300")
+    code, _, err = rosl.run("run", "tutorial_pkg", "timer_node")
+
+    assert code == 1
+    assert one_error_line(err) == (
+        "timer_node: ROSL_DOMAIN_ID=300 is out of range: domain ids go from 0 to 232"
+    )
+
+
+def test_run_domain_id_option_is_checked_like_the_environment(rosl: Rosl) -> None:
+    code, _, err = rosl.run("run", "--domain-id", "300", "tutorial_pkg", "timer_node")
+
+    assert code == 1
+    assert one_error_line(err) == "--domain-id=300 is out of range: domain ids go from 0 to 232"

@@ -172,3 +172,26 @@ def test_a_yaml_node_missing_its_package_names_the_file_and_line(
     assert code == 1
     assert "process started" not in out
     assert one_error_line(err) == f"{path}:4: missing 'pkg:'"
+
+
+def test_an_unknown_yaml_node_attribute_is_one_line_with_the_closest_name(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    path = write_launch(
+        launch_dir,
+        "attribute.launch.yaml",
+        """
+        launch:
+        - node:
+            pkg: tutorial_pkg
+            exec: timer_node
+            nme: t1
+        """,
+    )
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 1
+    assert "process started" not in out
+    line = one_error_line(err)
+    assert line.startswith(f"{path}:3: unknown attribute 'nme' in 'node' (did you mean 'name'?)")

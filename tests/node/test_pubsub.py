@@ -314,3 +314,38 @@ def test_a_message_of_another_type_is_dropped_with_one_warning_and_never_misdeco
     )
     assert len(warnings) == 1, err
     assert "std_msgs/msg/String" in warnings[0]
+
+
+LISTENER = """
+import rosl
+from std_msgs.msg import String
+
+rosl.init()
+node = rosl.Node("gap_listener")
+node.create_subscription(String, "gaps", lambda msg: print("heard", msg.data, flush=True), 10)
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def test_a_subscriber_logs_the_messages_it_lost_to_sequence_gaps(ros, spawn):
+    from rosl.bus.header import Kind
+    from std_msgs.msg import String
+
+    child = spawn(LISTENER)
+    child.expect("^ready$")
+    node = ros.Node("gappy_talker")
+    pub = node.create_publisher(String, "gaps", 10)
+    assert pub.wait_for_subscribers(1, 10.0) == 1
+    data = pub._store.serialize(String(data="x"))
+    for seq in (1, 2, 5):  # 3 and 4 never go out: what a full socket buffer does
+        pub._writer.send(data, kind=Kind.DATA, seq=seq)
+    child.expect("^heard x$")
+    child.expect("^heard x$")
+    child.expect("^heard x$")
+    warning = child.expect(r"^.*lost \d+ message\(s\) on /gaps.*$", stream="err").group(0)
+    assert "[WARN]" in warning
+    assert "[gap_listener]" in warning
+    assert "lost 2 message(s) on /gaps" in warning
+    _, err = child.stop()
+    assert err.count("lost ") == 1  # once, not once per message
