@@ -1,11 +1,16 @@
-"""``rosl bag info``: ROS 2's layout (and ``--json``) for a folder or a single MCAP file."""
+"""``rosl bag info``: ROS 2's layout (and ``--json``) for a folder or a single MCAP file.
+
+A finished file is described by its MCAP summary (statistics, channels, schemas) without
+reading its messages; only an unfinished file (no summary) is read record by record.
+"""
 
 from __future__ import annotations
 
 import datetime
 from typing import TYPE_CHECKING, Any
 
-from rosl.bag.reader import Channel, bag_files, channels, has_summary
+from rosl.bag.reader import has_summary
+from rosl.bag.trim import SourceChannel, scan
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -14,32 +19,29 @@ LABEL = 19
 
 
 def summary(target: Path) -> dict[str, Any]:
-    """What ``info`` reports, as plain data."""
-    files, meta = bag_files(target)
-    found = channels(target)
-    times: list[int] = []
-    from rosl.bag.reader import iter_file
+    """What ``info`` reports, as plain data.
 
-    for path in files:
-        for message in iter_file(path):
-            times.append(message.log_time)
-    start, end = (min(times), max(times)) if times else (0, 0)
-    for entry in (meta or {}).get("topics_with_message_count") or []:
+    Raises:
+        BagError: the bag cannot be read.
+    """
+    found = scan(target)
+    channels = {name: c for name, c in found.channels.items() if c.count}  # as a scan finds
+    for entry in (found.info or {}).get("topics_with_message_count") or []:
         listed = entry.get("topic_metadata") or {}
         name = str(listed.get("name", ""))
-        if name and name not in found:  # subscribed, but nothing came: ROS 2 lists it (Count: 0)
-            found[name] = Channel(name, str(listed.get("type", "")), "", "")
-    topics = [c for c in found.values() if not c.topic.endswith("/_service_event")]
-    services = [c for c in found.values() if c.topic.endswith("/_service_event")]
+        if name and name not in channels:  # subscribed, but nothing came: ROS 2 lists it (Count: 0)
+            channels[name] = SourceChannel(name, str(listed.get("type", "")), "", b"")
+    topics = [c for c in channels.values() if not c.topic.endswith("/_service_event")]
+    services = [c for c in channels.values() if c.topic.endswith("/_service_event")]
     return {
-        "files": [p.name for p in files],
-        "unfinished": [p.name for p in files if not has_summary(p)],
-        "bag_size": sum(p.stat().st_size for p in files),
+        "files": [p.name for p in found.files],
+        "unfinished": [p.name for p in found.files if not has_summary(p)],
+        "bag_size": sum(p.stat().st_size for p in found.files),
         "storage_id": "mcap",
-        "ros_distro": (meta or {}).get("ros_distro", "") or "",
-        "duration_ns": end - start,
-        "start_ns": start,
-        "end_ns": end,
+        "ros_distro": (found.info or {}).get("ros_distro", "") or "",
+        "duration_ns": found.end_ns - found.start_ns,
+        "start_ns": found.start_ns,
+        "end_ns": found.end_ns,
         "messages": sum(c.count for c in topics),
         "topics": [
             {"name": c.topic, "type": c.type, "count": c.count, "serialization_format": "cdr"}

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -118,23 +119,90 @@ def write(
         )
         temporary.replace(path)
     except OSError as err:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
         raise BagError(f"cannot write {path}: {err.strerror}") from None
     return path
 
 
 def read(folder: Path) -> dict[str, Any]:
-    """Read a folder's ``metadata.yaml``.
+    """Read a folder's ``metadata.yaml``, its keys checked to have rosbag2's shapes.
 
     Raises:
-        BagError: not YAML or not rosbag2's layout.
+        BagError: not YAML, not rosbag2's layout, or a key of the wrong shape (named).
     """
     path = folder / "metadata.yaml"
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        information = data["rosbag2_bagfile_information"]
-        information["relative_file_paths"]
-    except (OSError, yaml.YAMLError, KeyError, TypeError) as err:
+    except OSError as err:
+        raise BagError(f"cannot read {path}: {err.strerror}") from None
+    except UnicodeDecodeError:
+        raise BagError(f"{path} is not a rosbag2 metadata file (not UTF-8 text)") from None
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(path)
+        problem = getattr(err, "problem", None) or type(err).__name__
+        raise BagError(f"{where}: not valid YAML ({problem})") from None
+    information = data.get("rosbag2_bagfile_information") if isinstance(data, dict) else None
+    if not isinstance(information, dict):
         raise BagError(
-            f"{path} is not a rosbag2 metadata file ({type(err).__name__}: {err})"
-        ) from None
-    return information  # type: ignore[no-any-return]
+            f"{path} is not a rosbag2 metadata file (no 'rosbag2_bagfile_information' mapping)"
+        )
+    _check_shapes(path, information)
+    return information
+
+
+def _check_shapes(path: Path, information: dict[str, Any]) -> None:
+    """Raise a BagError naming the first key whose value has the wrong shape."""
+    if "relative_file_paths" not in information:
+        raise BagError(f"{path}: 'relative_file_paths' is missing")
+    _expect(path, "relative_file_paths", information["relative_file_paths"], list)
+    for index, name in enumerate(information["relative_file_paths"]):
+        _expect(path, f"relative_file_paths[{index}]", name, str)
+    for key, kind in (("ros_distro", str), ("custom_data", dict), ("storage_identifier", str)):
+        if information.get(key) is not None:
+            _expect(path, key, information[key], kind)
+    for index, entry in enumerate(_optional_list(path, information, "files")):
+        key = f"files[{index}]"
+        _expect(path, key, entry, dict)
+        _expect(path, f"{key}.path", entry.get("path"), str)
+        if entry.get("message_count") is not None:
+            _expect(path, f"{key}.message_count", entry["message_count"], int)
+    for index, entry in enumerate(_optional_list(path, information, "topics_with_message_count")):
+        key = f"topics_with_message_count[{index}]"
+        _expect(path, key, entry, dict)
+        meta = entry.get("topic_metadata")
+        _expect(path, f"{key}.topic_metadata", meta, dict)
+        for name in ("name", "type"):
+            _expect(path, f"{key}.topic_metadata.{name}", meta.get(name), str)
+        for name in ("serialization_format", "type_description_hash"):
+            if meta.get(name) is not None:
+                _expect(path, f"{key}.topic_metadata.{name}", meta[name], str)
+        qos = meta.get("offered_qos_profiles")
+        if qos is not None and not isinstance(qos, (list, str)):  # a YAML text before v9
+            _expect(path, f"{key}.topic_metadata.offered_qos_profiles", qos, list)
+        if entry.get("message_count") is not None:
+            _expect(path, f"{key}.message_count", entry["message_count"], int)
+
+
+def _optional_list(path: Path, information: dict[str, Any], key: str) -> list[Any]:
+    value = information.get(key)
+    if value is None:
+        return []
+    _expect(path, key, value, list)
+    return value  # type: ignore[no-any-return]
+
+
+_SHAPES = {list: "a list", dict: "a mapping", str: "a text", int: "a whole number"}
+
+
+def _expect(path: Path, key: str, value: Any, kind: type) -> None:
+    if isinstance(value, kind) and not (kind is int and isinstance(value, bool)):
+        return
+    found = "nothing" if value is None else f"{type(value).__name__} {_short(value)}"
+    raise BagError(f"{path}: '{key}' must be {_SHAPES[kind]}, not {found}")
+
+
+def _short(value: Any) -> str:
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= 40 else text[:37] + "..."

@@ -6,6 +6,7 @@ last complete one, and said so; ``rosl bag reindex`` rewrites it whole.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
 
@@ -13,10 +14,11 @@ from rosl.bag import metadata
 from rosl.bag.errors import BagError
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from collections.abc import Iterable, Iterator
     from pathlib import Path
 
 MAGIC = b"\x89MCAP0\r\n"
+_SPLIT_INDEX = re.compile(r"^(?P<stem>.*?)(?:_(?P<index>\d+))?$")
 
 
 @dataclass(frozen=True, slots=True)
@@ -34,19 +36,6 @@ class BagMessage:
     channel_metadata: dict[str, str] = field(default_factory=dict)  # offered_qos_profiles
 
 
-@dataclass(slots=True)
-class Channel:
-    """One channel (topic) of a bag."""
-
-    topic: str
-    type: str
-    schema_encoding: str
-    schema_text: str
-    count: int = 0
-    qos: list[dict[str, Any]] = field(default_factory=list)
-    type_hash: str = ""
-
-
 def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
     """The MCAP files of a bag (folder or file) and its metadata, if any.
 
@@ -56,7 +45,7 @@ def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
     if not target.exists():
         raise BagError(f"no recording at '{target}'")
     if target.is_file():
-        _check_magic(target)
+        check_magic(target)
         return [target], None
     if (target / "metadata.yaml").is_file():
         info = metadata.read(target)
@@ -69,15 +58,36 @@ def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
             )
     else:
         info = None
-        files = sorted(target.glob("*.mcap"))
+        files = split_order(target.glob("*.mcap"))
         if not files:
             raise BagError(f"'{target}' holds no metadata.yaml and no .mcap files")
     for path in files:
-        _check_magic(path)
+        check_magic(path)
     return files, info
 
 
-def _check_magic(path: Path) -> None:
+def split_order(paths: Iterable[Path]) -> list[Path]:
+    """MCAP files in the order they were split: ``run_2`` before ``run_10``.
+
+    Files are grouped by their name without the trailing ``_N`` and ordered by ``N`` as a
+    number (a name without an index first).
+    """
+
+    def key(path: Path) -> tuple[str, int, str]:
+        match = _SPLIT_INDEX.match(path.stem)
+        assert match is not None  # every name matches: the index is optional
+        index = match["index"]
+        return (match["stem"], int(index) if index is not None else -1, path.name)
+
+    return sorted(paths, key=key)
+
+
+def check_magic(path: Path) -> None:
+    """Raise a one-line BagError unless ``path`` starts with the MCAP magic.
+
+    Raises:
+        BagError: the file cannot be read or is not MCAP.
+    """
     try:
         with path.open("rb") as handle:
             head = handle.read(len(MAGIC))
@@ -169,25 +179,3 @@ def iter_bag(target: Path, topics: set[str] | None = None) -> Iterator[BagMessag
     files, _ = bag_files(target)
     for path in files:
         yield from iter_file(path, topics)
-
-
-def channels(target: Path) -> dict[str, Channel]:
-    """The topics of a bag with their types, schemas and counts (from summaries if present)."""
-    files, info = bag_files(target)
-    found: dict[str, Channel] = {}
-    for path in files:
-        for message in iter_file(path):
-            channel = found.get(message.topic)
-            if channel is None:
-                channel = found[message.topic] = Channel(
-                    message.topic, message.type, message.schema_encoding, message.schema_text
-                )
-            channel.count += 1
-    if info is not None:
-        for entry in info.get("topics_with_message_count", []):
-            meta = entry["topic_metadata"]
-            channel = found.get(meta["name"])
-            if channel is not None:
-                channel.qos = list(meta.get("offered_qos_profiles") or [])
-                channel.type_hash = meta.get("type_description_hash", "")
-    return found

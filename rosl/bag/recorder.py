@@ -10,14 +10,15 @@ thread (``schemas.py``), so log times stay receive times when a topic appears mi
 Chunks go to disk (flushed and fsynced) at least once a second, so a killed recorder loses at
 most the last second; ``rosl bag reindex`` repairs such a folder. As rosbag2 does, a file is
 split before the message that would make it longer than ``max_bag_duration`` (by log time)
-or once it has reached ``max_bag_size`` bytes (counted as messages are written).
+or once it has reached ``max_bag_size`` bytes (counted as messages are written). A topic is
+recorded with the first type seen on it; messages of another type on it are counted and
+reported, never written (``selection.py``).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import re
 import sys
 import time
 from dataclasses import dataclass, field
@@ -26,8 +27,9 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 from rosl.bag import metadata
 from rosl.bag.errors import BagError
 from rosl.bag.schemas import PENDING_LIMIT_S, Schemas
+from rosl.bag.selection import RECORDER_NODE, OtherTypes, Selection, sender_name
 from rosl.bus.header import Kind, topic_hash, type_hash
-from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION, is_hidden
+from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -39,6 +41,8 @@ if TYPE_CHECKING:
 FLUSH_EVERY_S = 1.0
 PENDING_MAX = 20000
 MESSAGE_RECORD = 31  # bytes of an MCAP message record besides its data
+_SUBSCRIPTION_QOS = {"reliability": "RELIABLE", "durability": "VOLATILE", "history": "KEEP_LAST",
+                     "depth": 1000}  # fmt: skip
 
 
 @dataclass(slots=True)
@@ -88,11 +92,15 @@ class Recorder:
         domain: int | str | None = None,
         log: Callable[[str], None] | None = None,
     ) -> None:
+        for flag, limit in (
+            ("--max-bag-size", max_bag_size),
+            ("--max-bag-duration", max_bag_duration),
+        ):
+            if limit < 0:
+                raise BagError(f"{flag} must be 0 (no splitting) or more, not {limit}")
         self.folder = folder
-        self.topics = set(topics) if topics else None
-        self.exclude = re.compile(exclude) if exclude else None
+        self.selection = Selection.parse(topics, exclude, include_hidden)
         self.services = services
-        self.include_hidden = include_hidden
         self.max_bag_size = max_bag_size
         self.max_bag_duration = max_bag_duration
         self.compression = compression
@@ -113,6 +121,7 @@ class Recorder:
         self._last_flush = time.monotonic()
         self.dropped_unknown = 0
         self.skipped_types: set[str] = set()
+        self.other_types = OtherTypes(self._log)  # a second type on a recorded topic
         self.stopped = False
         self.sim_time = False  # set by record_at: log times come from a simulator's clock
         self._chunk_ns = 0
@@ -139,10 +148,10 @@ class Recorder:
         self.participant = Participant(self.domain)
         self._schemas = Schemas(self.participant, self._log)
         self._node_index = self.participant.add_node(self._describe)
-        if self.topics is None or self.services:
+        if self.selection.topics is None or self.services:
             self.participant.listen_all()
         else:
-            for name in self.topics:
+            for name in sorted(self.selection.topics):
                 self.participant.listen(topic_hash(name), _Ignore())
         discovery = self.participant.discovery
         discovery.wait_complete(discovery.query(), timeout=1.0)
@@ -256,6 +265,7 @@ class Recorder:
                 if self.dropped_unknown
                 else ""
             )
+            + self.other_types.note()
         )
 
     # --- files -------------------------------------------------------------------------------
@@ -359,20 +369,13 @@ class Recorder:
             return None
         return found
 
-    def _wanted(self, name: str) -> bool:
-        if self.topics is not None and name not in self.topics:
-            return False
-        if self.exclude is not None and self.exclude.search(name):
-            return False
-        return self.include_hidden or not is_hidden(name)
-
     def _record_data(self, delivery: Delivery) -> None:
         found = self._resolve(delivery, (PUBLISHER, SUBSCRIPTION))
         if found is None:
             self._hold(delivery)
             return
         name, type_name, _ = found
-        if not self._wanted(name):
+        if not self.selection.wanted(name) or self._other_type(name, type_name, delivery):
             return
         topic = self._subscribe(name, type_name)
         if topic is None:
@@ -390,7 +393,7 @@ class Recorder:
             return
         service, service_type, _ = found
         name = event_topic(service)
-        if self.exclude is not None and self.exclude.search(name):
+        if self.selection.excluded(name):
             return
         try:
             event = event_from_delivery(delivery, service_type)
@@ -404,6 +407,8 @@ class Recorder:
             return
         from rosl.idl import registry
 
+        if self._other_type(name, event_type_name(service_type), delivery):
+            return
         topic = self._subscribe(name, event_type_name(service_type), qos={"depth": 10})
         if topic is None:
             self._hold(delivery)
@@ -462,6 +467,15 @@ class Recorder:
         current.channels[name] = channel_id
         return channel_id
 
+    def _other_type(self, name: str, type_name: str, delivery: Delivery) -> bool:
+        """Whether ``name`` is recorded with another type (the message is counted, not written)."""
+        assert self.participant is not None
+        existing = self._topics.get(name)
+        graph = self.participant.graph
+        return existing is not None and self.other_types.left_out(
+            name, existing.info.type, type_name, lambda: sender_name(graph, delivery, name)
+        )
+
     def _subscribe(
         self, name: str, type_name: str, qos: dict[str, Any] | None = None
     ) -> _Topic | None:
@@ -475,7 +489,9 @@ class Recorder:
             return None
         encoding, text, digest = found
         assert self.participant is not None
-        info = metadata.TopicInfo(name, type_name, qos=self._qos(name, qos), type_hash=digest)
+        info = metadata.TopicInfo(
+            name, type_name, qos=self._qos(name, type_name, qos), type_hash=digest
+        )
         topic = _Topic(info, encoding, text, self.participant.next_endpoint())
         self._topics[name] = topic
         self._log(f"[INFO] [rosl_recorder]: Subscribed to topic '{name}'")
@@ -494,12 +510,12 @@ class Recorder:
         self._schemas.arrived = False  # before looking: a schema arriving now is seen next time
         self._synced = graph.generation
         for _, endpoint in graph.endpoints(PUBLISHER):
-            if endpoint.name not in self._topics and self._wanted(endpoint.name):
+            if endpoint.name not in self._topics and self.selection.wanted(endpoint.name):
                 self._subscribe(endpoint.name, endpoint.type)
         if self.services:
             for _, endpoint in graph.endpoints(SERVER):
                 name = event_topic(endpoint.name)
-                if name not in self._topics and not (self.exclude and self.exclude.search(name)):
+                if name not in self._topics and not self.selection.excluded(name):
                     try:
                         self._subscribe(name, event_type_name(endpoint.type), qos={"depth": 10})
                     except Exception:
@@ -516,26 +532,23 @@ class Recorder:
                 name,
                 t.info.type,
                 t.endpoint,
-                {
-                    "reliability": "RELIABLE",
-                    "durability": "VOLATILE",
-                    "history": "KEEP_LAST",
-                    "depth": 1000,
-                },
+                dict(_SUBSCRIPTION_QOS),
                 {"received": t.info.count},
             )
             for name, t in list(self._topics.items())
         )
-        return NodeRecord(
-            "rosbag2_recorder", "/", self.participant.sender, self._node_index, endpoints
-        )
+        return NodeRecord(RECORDER_NODE, "/", self.participant.sender, self._node_index, endpoints)
 
-    def _qos(self, name: str, given: dict[str, Any] | None) -> list[dict[str, Any]]:
+    def _qos(self, name: str, type_name: str, given: dict[str, Any] | None) -> list[dict[str, Any]]:
+        """The offered QoS of the topic's publishers of the recorded type (or ``given``)."""
         assert self.participant is not None
         if given is not None:
             return [metadata.qos_entry(given)]
+        graph = self.participant.graph
         entries = [
-            metadata.qos_entry(e.qos) for _, e in self.participant.graph.endpoints(PUBLISHER, name)
+            metadata.qos_entry(e.qos)
+            for _, e in graph.endpoints(PUBLISHER, name)
+            if e.type == type_name
         ]
         return sorted(entries, key=repr)
 
@@ -548,12 +561,12 @@ class Recorder:
         types = {
             endpoint.type
             for _, endpoint in graph.endpoints(PUBLISHER)
-            if endpoint.name not in self._topics and self._wanted(endpoint.name)
+            if endpoint.name not in self._topics and self.selection.wanted(endpoint.name)
         }
         if self.services:
             for _, endpoint in graph.endpoints(SERVER):
                 name = event_topic(endpoint.name)
-                if name not in self._topics and not (self.exclude and self.exclude.search(name)):
+                if name not in self._topics and not self.selection.excluded(name):
                     types.add(event_type_name(endpoint.type))
         return types
 

@@ -55,6 +55,7 @@ class Scan:
     unfinished: list[Path]
     info: dict[str, Any] | None
     compression: str = ""
+    files: list[Path] = field(default_factory=list)
 
 
 @dataclass(slots=True)
@@ -93,7 +94,7 @@ def scan(target: Path) -> Scan:
     from mcap.exceptions import McapError
 
     files, info = bag_files(target)
-    found = Scan({}, 0, 0, 0, [], info)
+    found = Scan({}, 0, 0, 0, [], info, files=files)
     for path in files:
         try:
             with path.open("rb") as handle:

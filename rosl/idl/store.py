@@ -135,6 +135,29 @@ class Store:
         """Return the RIHS01 hash ROS 2 (Iron and later) gives this type."""
         return self._typestore.hash_rihs01(type_name)
 
+    def schema_type_hash(self, type_name: str, encoding: str, text: str) -> str:
+        """Return the RIHS01 hash of a type as a recording's schema defines it.
+
+        The schema is read as :meth:`deserialize_with_schema` reads it (its own type store),
+        so a type this process cannot load from .msg files still gets its hash.
+
+        Raises:
+            InterfaceError: the schema cannot be read, or it does not define ``type_name``.
+        """
+        key = (type_name, encoding, text)
+        with self._lock:
+            typestore = self._schemas.get(key)
+        if typestore is None:
+            typestore = _schema_typestore(type_name, encoding, text)
+            with self._lock:
+                typestore = self._schemas.setdefault(key, typestore)
+        try:
+            return typestore.hash_rihs01(type_name)
+        except Exception as err:  # rosbags raises several kinds for an incomplete definition
+            raise InterfaceError(
+                f"cannot hash {type_name} from its {encoding} schema: {type(err).__name__}: {err}"
+            ) from None
+
     def fielddefs(self, type_name: str) -> Any:
         """Return rosbags' (constants, fields) entry for a registered type."""
         return self._typestore.fielddefs[type_name]

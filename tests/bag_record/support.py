@@ -252,10 +252,31 @@ def topic_counts(folder: Path) -> dict[str, int]:
 
 
 def bag_files(folder: Path) -> list[Path]:
-    """The bag's files in metadata order (or sorted .mcap files without metadata)."""
+    """The bag's files in metadata order (or by their split index without metadata)."""
     if (folder / "metadata.yaml").is_file():
         return [folder / name for name in metadata(folder)["relative_file_paths"]]
-    return sorted(folder.glob("*.mcap"))
+
+    def split_index(path: Path) -> tuple[str, int]:
+        stem, _, index = path.stem.rpartition("_")
+        return (stem, int(index)) if index.isdigit() else (path.stem, -1)
+
+    return sorted(folder.glob("*.mcap"), key=split_index)
+
+
+def complete_messages(path: Path) -> list[bytes]:
+    """The payloads of the complete message records of a (possibly cut) MCAP file."""
+    from mcap.records import Message
+    from mcap.stream_reader import StreamReader
+
+    found = []
+    with path.open("rb") as handle:
+        try:
+            for record in StreamReader(handle, skip_magic=False, emit_chunks=False).records:
+                if isinstance(record, Message):
+                    found.append(bytes(record.data))
+        except Exception:  # the torn tail of the file
+            pass
+    return found
 
 
 def typestore_from(definitions: list[tuple[str, str, str]]) -> Any:

@@ -95,6 +95,25 @@ def test_recording_into_a_read_only_folder_fails_with_one_line(
         parent.chmod(0o700)
 
 
+@pytest.mark.parametrize(
+    ("args", "start"),
+    [
+        (["--exclude", "(["], "--exclude: not a valid regular expression"),
+        (["--max-bag-size", "-5"], "--max-bag-size must be 0"),
+        (["--max-bag-duration", "-1.5"], "--max-bag-duration must be 0"),
+    ],
+)
+def test_bad_record_options_are_refused_in_one_line_before_recording(
+    tmp_path: Path, domain_id: int, args: list[str], start: str
+) -> None:
+    folder = tmp_path / "run"
+    result = support.rosl_run("bag", "record", "-a", *args, "-o", str(folder), cwd=tmp_path)
+    line = one_line_error(result)
+    assert line.startswith(start), line
+    assert "Recording" not in result.stderr
+    assert not folder.exists()
+
+
 # --- damaged bags ------------------------------------------------------------------------------
 
 
@@ -166,6 +185,29 @@ def test_metadata_naming_missing_files_is_reported_in_one_line_suggesting_reinde
     assert "ghost_7.mcap" not in support.metadata(bag_copy)["relative_file_paths"]
     assert support.topic_counts(bag_copy)["/counter"] == COUNT
     assert counter_values(bag_copy) == list(range(1, COUNT + 1))
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("relative_file_paths", 5),
+        ("relative_file_paths", [3]),
+        ("topics_with_message_count", 3),
+        ("topics_with_message_count", [{"topic_metadata": "x"}]),
+        ("files", {"path": "x"}),
+    ],
+)
+def test_metadata_of_the_wrong_shape_is_reported_in_one_line_naming_file_and_key(
+    bag_copy: Path, key: str, value: object
+) -> None:
+    path = bag_copy / "metadata.yaml"
+    data = yaml.safe_load(path.read_text())
+    data["rosbag2_bagfile_information"][key] = value
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    for command in (["info"], ["info", "--json"], ["diff", str(bag_copy)]):
+        line = one_line_error(support.rosl_run("bag", *command, str(bag_copy)))
+        assert str(path) in line, line
+        assert key in line, line
 
 
 def test_a_truncated_mcap_is_reported_unfinished_and_reindex_keeps_its_complete_part(

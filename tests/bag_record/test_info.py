@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import datetime
 import json
+import shutil
 from typing import TYPE_CHECKING
 
 from tests.bag_record import support
@@ -172,3 +173,59 @@ def test_info_without_a_known_distro_says_unknown_as_ros2_does(service_bag: Serv
     lines = support.rosl_run("bag", "info", str(path)).stdout.splitlines()
     distro = [line for line in lines if line.startswith("ROS Distro:")]
     assert distro == [f"{'ROS Distro:':<19}unknown"], distro
+
+
+def footer_summary_start(path: Path) -> int:
+    """The summary section's offset, from the footer record before the closing magic."""
+    data = path.read_bytes()
+    footer = data[-8 - 29 :]  # opcode, length, summary_start, summary_offset_start, crc
+    assert footer[0] == 0x02, "not a footer record"
+    return int.from_bytes(footer[9:17], "little")
+
+
+def test_info_of_a_finished_file_answers_from_its_summary_without_reading_chunks(
+    service_bag: ServiceBag, tmp_path: Path
+) -> None:
+    """Every chunk of a copy is overwritten with garbage; its summary is left whole. ``info``
+    reads the summary (statistics, channels, schemas) only, so it prints what it printed for
+    the original file."""
+    from mcap.reader import make_reader
+
+    (original,) = support.bag_files(service_bag.folder)
+    path = tmp_path / original.name
+    shutil.copy(original, path)
+    with path.open("rb") as handle:
+        summary = make_reader(handle).get_summary()
+    assert summary is not None
+    assert summary.chunk_indexes
+    with path.open("r+b") as handle:
+        for chunk in summary.chunk_indexes:
+            handle.seek(chunk.chunk_start_offset + 9 + 40)  # past opcode, length, header fields
+            handle.write(b"\xff" * (chunk.chunk_length - 9 - 40))
+    assert path.stat().st_size == original.stat().st_size
+    expected = support.rosl_run("bag", "info", str(original))
+    assert expected.returncode == 0, expected.stderr
+    result = support.rosl_run("bag", "info", str(path))
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == expected.stdout
+    assert "Topic: /numbers | Type: std_msgs/msg/Int32 | Count: 5 |" in result.stdout
+
+
+def test_info_of_an_unfinished_file_scans_it_to_the_same_numbers(
+    service_bag: ServiceBag, tmp_path: Path
+) -> None:
+    """A copy cut where its summary begins holds every message but no summary: info reads
+    it record by record and prints the same table, plus the note that it is unfinished."""
+    (original,) = support.bag_files(service_bag.folder)
+    path = tmp_path / original.name
+    shutil.copy(original, path)
+    with path.open("r+b") as handle:
+        handle.truncate(footer_summary_start(path))
+    finished = json.loads(support.rosl_run("bag", "info", "--json", str(original)).stdout)
+    result = support.rosl_run("bag", "info", "--json", str(path))
+    assert result.returncode == 0, result.stderr
+    scanned = json.loads(result.stdout)
+    assert scanned.pop("unfinished") == [path.name]
+    assert finished.pop("unfinished") == []
+    del scanned["bag_size"], finished["bag_size"]
+    assert scanned == finished

@@ -1,7 +1,8 @@
 """Which topics a recorder takes: named topics, ``--exclude REGEX``, and how others see it.
 
-Two recorders run at once on one domain: ``rosl bag record /wanted /also`` and
-``rosl bag record -a --exclude '^/(also|noise)'``. One publisher sends on /wanted, /also and
+Three recorders run at once on one domain: ``rosl bag record /wanted /also``,
+``rosl bag record -a --exclude '^/(also|noise)'`` and ``rosl bag record wanted`` (a relative
+name, which ros2 bag record expands to ``/wanted``). One publisher sends on /wanted, /also and
 /noise; then ``rosl topic pub --once /ping`` and ``rosl node list`` run while both record.
 """
 
@@ -23,7 +24,7 @@ if TYPE_CHECKING:
     from tests.bag_record.conftest import DomainProcesses
 
 PUBLISHERS = [
-    {"topic": "/wanted", "type": "std_msgs/msg/String", "wait": 2},
+    {"topic": "/wanted", "type": "std_msgs/msg/String", "wait": 3},
     {"topic": "/also", "type": "std_msgs/msg/Int32", "wait": 1},
     {"topic": "/noise", "type": "std_msgs/msg/Int32", "wait": 0},
 ]
@@ -38,6 +39,8 @@ MESSAGES = [
 class Selection:
     named: Path
     excluded: Path
+    relative: Path
+    relative_stderr: str
     pub: CompletedProcess[str]
     node_list: CompletedProcess[str]
 
@@ -46,12 +49,14 @@ class Selection:
 def selection(module_bus: DomainProcesses, module_dir: Path) -> Selection:
     named_dir = module_dir / "named"
     excluded_dir = module_dir / "excluded"
+    relative_dir = module_dir / "relative"
     named = support.start_recorder(
         module_bus, "/wanted", "/also", "-o", str(named_dir), cwd=module_dir
     )
     excluded = support.start_recorder(
         module_bus, "-a", "--exclude", "^/(also|noise)", "-o", str(excluded_dir), cwd=module_dir
     )
+    relative = support.start_recorder(module_bus, "wanted", "-o", str(relative_dir), cwd=module_dir)
     support.run_publisher(
         module_bus,
         {"node": "selection_talker", "publishers": PUBLISHERS, "messages": MESSAGES,
@@ -67,7 +72,8 @@ def selection(module_bus: DomainProcesses, module_dir: Path) -> Selection:
     )
     support.stop_recorder(named, signal.SIGINT)
     support.stop_recorder(excluded, signal.SIGINT)
-    return Selection(named_dir, excluded_dir, pub, node_list)
+    relative_stderr = support.stop_recorder(relative, signal.SIGINT)
+    return Selection(named_dir, excluded_dir, relative_dir, relative_stderr, pub, node_list)
 
 
 def test_recording_named_topics_keeps_only_those_topics(selection: Selection) -> None:
@@ -75,6 +81,13 @@ def test_recording_named_topics_keeps_only_those_topics(selection: Selection) ->
     messages = support.by_topic(support.read_anyreader(selection.named))
     assert [m.fields["data"] for m in messages["/wanted"]] == ["w0", "w1", "w2", "w3"]
     assert [m.fields["data"] for m in messages["/also"]] == [0, 1, 2]
+
+
+def test_a_relative_topic_name_is_recorded_as_its_absolute_name(selection: Selection) -> None:
+    assert support.topic_counts(selection.relative) == {"/wanted": 4}
+    messages = support.by_topic(support.read_anyreader(selection.relative))
+    assert [m.fields["data"] for m in messages["/wanted"]] == ["w0", "w1", "w2", "w3"]
+    assert "Subscribed to topic '/wanted'" in selection.relative_stderr
 
 
 def test_exclude_regex_leaves_out_the_matching_topics(selection: Selection) -> None:

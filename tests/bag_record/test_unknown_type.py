@@ -112,3 +112,34 @@ def test_a_publisher_of_a_type_the_recorder_asked_for_sees_the_recorder_matched(
     support.stop_recorder(recorder, signal.SIGINT)
     assert code == 0, f"the recorder never matched /reading\n{waiting.both()}"
     assert support.topic_counts(folder)["/reading"] == len(MESSAGES)
+
+
+def test_reindex_hashes_a_type_it_does_not_know_from_the_schema_in_the_file(
+    processes: Processes, make_package: Callable[..., Path], workspace: Path, tmp_path: Path
+) -> None:
+    """metadata.yaml rebuilt by a process that cannot read bagtest_msgs still carries the
+    type's RIHS01 hash: reindex computes it from the definition the MCAP file holds."""
+    make_package("bagtest_msgs", {"msg/Reading.msg": READING, "msg/Sample.msg": SAMPLE})
+    expected_text = registry.msgdef_text(TYPE)
+    empty = tmp_path / "recorder_cwd"
+    empty.mkdir()
+    folder = tmp_path / "custom_bag"
+    recorder = support.start_recorder(processes, "/reading", "-o", str(folder), cwd=empty)
+    support.run_publisher(
+        processes,
+        {"node": "custom_talker", "publishers": [{"topic": "/reading", "type": TYPE}],
+         "messages": [(0, m) for m in MESSAGES]},
+        cwd=workspace,
+    )  # fmt: skip
+    support.stop_recorder(recorder, signal.SIGINT)
+    (folder / "metadata.yaml").unlink()
+
+    result = support.rosl_run("bag", "reindex", str(folder), cwd=empty)
+    assert result.returncode == 0, result.stderr
+    (entry,) = support.metadata(folder)["topics_with_message_count"]
+    assert entry["topic_metadata"]["type"] == TYPE
+    assert entry["message_count"] == len(MESSAGES)
+    assert entry["topic_metadata"]["type_description_hash"] == support.rihs01(
+        TYPE, "ros2msg", expected_text
+    )
+    assert entry["topic_metadata"]["type_description_hash"].startswith("RIHS01_")
