@@ -1,9 +1,12 @@
 """Throughput, one publisher process -> one subscriber process, rosl vs raw sockets.
 
 Prints, per payload size, delivered messages/s and MB/s for plain Python multicast sockets
-(the baseline, measured in the same run) and for rosl, at the bus level (bytes in, bytes out)
-and at the node level (publish a message, callback receives the decoded message), with the
-ratio to the baseline and the loss rosl counted. Publisher flat out (saturation).
+(the baseline, measured in the same run) and for rosl's bus (a Writer in this process, a
+Reader draining the topic's channel in the subscriber), publisher flat out (saturation), with
+the ratio to the baseline and the loss. Then, for 64 B and 1 KB, the same with the writer
+coalescing small messages (opt-in: ``create_publisher(..., coalesce=True)`` or
+``ROSL_COALESCE=1``). Last, the publisher paced at 80 % of the capacity measured above: the
+loss there must be 0.
 
     python bench/bus_throughput.py [--count N] [--runs R]
 """
@@ -83,25 +86,46 @@ def sub_bus(count: int, size: int) -> None:
     print(got, last - first, reader.lost() + reader.reassembler.incomplete, flush=True)
 
 
-def pub_bus(count: int, size: int) -> None:
+def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) -> None:
+    from rosl.bus.coalesce import DEFAULT_BYTES, Flusher
     from rosl.bus.multicast import Addressing
     from rosl.bus.transport import MulticastTransport
     from rosl.bus.wire import Writer
 
     transport = MulticastTransport(Addressing(BENCH_DOMAIN))
     writer = Writer(transport, 1, 1, "/bench", "bench/msg/Bytes")
+    flusher = Flusher()
+    if coalesce:
+        writer.coalesce(flusher, DEFAULT_BYTES)
     payload = bytes(size)
-    for _ in range(count):
-        writer.send(payload)
+    if rate:
+        start, clock = time.perf_counter(), time.perf_counter
+        for n in range(count):
+            due = start + n / rate
+            while clock() < due:
+                pass
+            writer.send(payload)
+    else:
+        for _ in range(count):
+            writer.send(payload)
+    flusher.close()
 
 
-def measure(kind: str, count: int, size: int) -> tuple[float, float]:
-    child = spawn([__file__, f"sub_{kind}", str(count), str(size)])
-    globals()[f"pub_{kind}"](count, size)
+def pub_coalesced(count: int, size: int) -> None:
+    pub_bus(count, size, coalesce=True)
+
+
+def measure(kind: str, count: int, size: int, rate: float = 0.0) -> tuple[float, float]:
+    sub = "raw" if kind == "raw" else "bus"
+    child = spawn([__file__, f"sub_{sub}", str(count), str(size)])
+    if rate:
+        pub_bus(count, size, rate=rate)
+    else:
+        globals()[f"pub_{kind}"](count, size)
     got, seconds, _lost = finish(child).split()
     got_n, secs = int(got), float(seconds)
-    rate = got_n / secs if secs > 0 else 0.0
-    return rate, 100.0 * (count - got_n) / count
+    delivered = got_n / secs if secs > 0 else 0.0
+    return delivered, 100.0 * (count - got_n) / count
 
 
 def main() -> None:
@@ -114,6 +138,8 @@ def main() -> None:
         f"{'ratio':>6} {'loss %':>7}"
     )
     raw60 = 0.0
+    capacity: dict[int, float] = {}
+    raw_rates: dict[int, float] = {}
     for size in SIZES:
         count = max(200, min(args.count, int(4e9 / max(size, 1) / 10)))
         raw_rate = 0.0
@@ -122,8 +148,10 @@ def main() -> None:
             raw_rate = sorted(r for r, _ in results)[len(results) // 2]
             if size == 60000:
                 raw60 = raw_rate * size / 1e6
+        raw_rates[size] = raw_rate
         results = [measure("bus", count, size) for _ in range(args.runs)]
         bus_rate, loss = sorted(results)[len(results) // 2]
+        capacity[size] = bus_rate
         base = raw_rate * size / 1e6 if raw_rate else raw60
         ratio = bus_rate * size / 1e6 / base if base else 0.0
         print(
@@ -132,6 +160,21 @@ def main() -> None:
             flush=True,
         )
     print("ratio = rosl MB/s / raw MB/s at the same size (1 MiB: / raw 60 KB MB/s)")
+    print(f"\n{'coalesced':>9} {'raw msg/s':>10} {'msg/s':>10} {'ratio':>6} {'loss %':>7}")
+    for size in (64, 1024):
+        count = args.count * 4
+        results = [measure("coalesced", count, size) for _ in range(args.runs)]
+        rate, loss = sorted(results)[len(results) // 2]
+        ratio = rate / raw_rates[size] if raw_rates[size] else 0.0
+        print(f"{size:>9} {raw_rates[size]:>10.0f} {rate:>10.0f} {ratio:>6.2f} {loss:>7.2f}")
+    print(f"\n{'paced 80%':>9} {'offered/s':>10} {'msg/s':>10} {'loss %':>7}")
+    for size in (64, 1024, 60000):
+        offered = 0.8 * capacity[size]
+        count = max(200, min(args.count, int(offered * 2)))  # about two seconds
+        results = [measure("bus", count, size, rate=offered) for _ in range(args.runs)]
+        rate, loss = max(results, key=lambda r: r[1])  # the worst run
+        print(f"{size:>9} {offered:>10.0f} {rate:>10.0f} {loss:>7.2f}")
+    print("paced: the worst of the runs; offered = 80 % of the flat-out rate measured above")
 
 
 if __name__ == "__main__":

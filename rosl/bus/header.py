@@ -57,6 +57,7 @@ class Flags(enum.IntFlag):
     NONE = 0
     ADDRESSED = 1  # the payload starts with an ADDRESS record
     LOCKSTEP = 2  # sent by a lock-stepped simulator: subscribers answer when they handled it
+    BATCH = 4  # the payload is several small messages of one endpoint (see coalesce.py)
 
 
 class Header(NamedTuple):

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
 from rosl.bus import header as hdr
+from rosl.bus.coalesce import Batch, split_records
 from rosl.bus.fragment import Reassembler, split
 from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
 from rosl.bus.transport import channel_of
@@ -23,12 +24,15 @@ if TYPE_CHECKING:
     import mmap
     import socket
 
+    from rosl.bus.coalesce import Flusher
     from rosl.bus.transport import Buffer, Transport
 
 _SMALL = 2048  # below this, joining header and payload beats a scatter send
 _unpack_header = HEADER.unpack_from
+_new_tuple = tuple.__new__  # builds a Delivery without its Python-level __new__ (per message)
 _MAGIC = hdr.MAGIC
 _ADDRESSED = int(Flags.ADDRESSED)  # plain ints: enum operators are slow per datagram
+_BATCH = int(Flags.BATCH)
 _DATA = int(Kind.DATA)
 _VERSION = hdr.VERSION
 
@@ -85,6 +89,18 @@ class Writer:
         self.sent = 0
         self.last_seq = 0  # the sequence number of the last message sent
         self.flags = 0  # extra header flags for every message (Flags.LOCKSTEP)
+        self.batch: Batch | None = None
+
+    def coalesce(self, flusher: Flusher, limit: int) -> None:
+        """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
+        self.batch = Batch(self._send_batch, min(limit, self.chunk), flusher)
+
+    def _send_batch(self, seq: int, stamp: int, records: bytes) -> None:
+        head = HEADER.pack(
+            _MAGIC, _VERSION, self.kind, self.flags | _BATCH, 1, self.sender, seq, self.topic,
+            self.type, 0, self.endpoint, len(records), stamp,
+        )  # fmt: skip
+        self.transport.send(self.channel, [head, records])
 
     def send(
         self,
@@ -112,6 +128,15 @@ class Writer:
         total = len(payload)
         when = time.time_ns() if stamp is None else stamp
         kind_value = self.kind if kind is None else kind
+        batch = self.batch
+        if batch is not None:
+            if flags == self.flags and kind_value == self.kind and batch.fits(total):
+                batch.add(number, when, payload)
+                self.sent += 1
+                if seq is None:
+                    self.last_seq = number
+                return number
+            batch.flush()  # what is pending goes first: the stream stays in order
         if total <= self.chunk:
             head = HEADER.pack(
                 _MAGIC, _VERSION, kind_value, flags, 1, self.sender, number, self.topic,
@@ -159,9 +184,9 @@ class Reader:
             True when the socket may hold more (the limit was reached).
         """
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
-        recv = sock.recv
+        recv, clock, streams = sock.recv, time.time_ns, self.streams
         if self.reassembler.pending:  # drop (and count) messages whose fragments stopped coming
-            now = time.time_ns()
+            now = clock()
             if now >= self._next_expiry:
                 self._next_expiry = now + 250_000_000
                 self.reassembler.expire(now)
@@ -172,18 +197,21 @@ class Reader:
                 return False
             except OSError:
                 return False  # closed while draining (shutdown)
-            now = time.time_ns()
+            now = clock()
             size = len(data)
-            if size < HEADER_SIZE or data[0:2] != _MAGIC:
+            if size < HEADER_SIZE:
                 self.foreign += 1
                 continue
-            (_, version, kind, flags, count, sender, seq, topic, type_, index,
+            (magic, version, kind, flags, count, sender, seq, topic, type_, index,
              endpoint, total, stamp) = _unpack_header(data)  # fmt: skip
-            if version != _VERSION or count == 0 or index >= count:
+            if magic != _MAGIC or version != _VERSION or count == 0 or index >= count:
                 self.foreign += 1
                 continue
             if (not want_all and topic not in wanted) or topic in ignored:
                 self.unwanted += 1
+                continue
+            if flags & _BATCH:
+                self._unbatch(data, kind, flags, sender, endpoint, topic, type_, total, now, out)
                 continue
             if count == 1:
                 if total != size - HEADER_SIZE:
@@ -207,14 +235,67 @@ class Reader:
                     continue
                 address = ADDRESS.unpack_from(payload)
                 payload = memoryview(payload)[ADDRESS_SIZE:]
+            if kind == _DATA:  # the stream's sequence check, inline: it runs per message
+                stats = streams.get((sender, endpoint))
+                if stats is None:
+                    stats = streams[(sender, endpoint)] = StreamStats(topic, last_seq=seq - 1)
+                step = (seq - stats.last_seq) & 0xFFFFFFFF
+                if 0 < step < 0x80000000:
+                    stats.lost += step - 1
+                    stats.last_seq = seq
+                stats.received += 1
+                stats.last_received = now
+            out.append(
+                _new_tuple(
+                    Delivery,
+                    (
+                        kind,
+                        sender,
+                        endpoint,
+                        seq,
+                        topic,
+                        type_,
+                        stamp,
+                        now,
+                        payload,
+                        address,
+                        flags,
+                    ),
+                )
+            )
+        return True
+
+    def _unbatch(
+        self,
+        data: bytes,
+        kind: int,
+        flags: int,
+        sender: int,
+        endpoint: int,
+        topic: int,
+        type_: int,
+        total: int,
+        now: int,
+        out: list[Delivery],
+    ) -> None:
+        """Split a coalesced datagram into one delivery per message."""
+        if total != len(data) - HEADER_SIZE:
+            self.reassembler.malformed += 1
+            return
+        try:
+            records = split_records(memoryview(data)[HEADER_SIZE:])
+        except ValueError:
+            self.reassembler.malformed += 1
+            return
+        flags &= ~_BATCH
+        for seq, stamp, payload in records:
             if kind == _DATA:
                 self._count(sender, endpoint, topic, seq, now)
             out.append(
                 Delivery(
-                    kind, sender, endpoint, seq, topic, type_, stamp, now, payload, address, flags
+                    kind, sender, endpoint, seq, topic, type_, stamp, now, payload, None, flags
                 )
             )
-        return True
 
     def _count(self, sender: int, endpoint: int, topic: int, seq: int, now: int) -> None:
         key = (sender, endpoint)

@@ -153,13 +153,22 @@ class Node:
         *,
         callback_group: Any = None,
         event_callbacks: Any = None,
+        coalesce: bool | None = None,
     ) -> Publisher:
-        """Create a publisher of ``msg_type`` on ``topic`` (relative names use the namespace)."""
+        """Create a publisher of ``msg_type`` on ``topic`` (relative names use the namespace).
+
+        ``coalesce=True`` batches small messages into shared datagrams, each at most 1 ms late
+        (default: the ``ROSL_COALESCE`` environment variable, else off).
+        """
         from rosl.node.publisher import Publisher
 
         del callback_group, event_callbacks
         publisher = Publisher(
-            self, _message_class(msg_type), self.resolve_topic_name(topic), as_profile(qos_profile)
+            self,
+            _message_class(msg_type),
+            self.resolve_topic_name(topic),
+            as_profile(qos_profile),
+            coalesce,
         )
         self.publishers.append(publisher)
         self.participant.discovery.changed()
@@ -253,7 +262,8 @@ class Node:
         return self.create_publisher(get_message_class(type_name), topic, qos)
 
     def destroy_publisher(self, publisher: Publisher) -> bool:
-        """Remove a publisher."""
+        """Remove a publisher (sending what it still holds)."""
+        publisher.flush()
         self.participant.remove_replayer(publisher.topic, publisher)
         if publisher._writer in self.participant.writers:
             self.participant.writers.remove(publisher._writer)

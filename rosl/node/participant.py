@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     import socket
     from collections.abc import Callable
 
+    from rosl.bus.coalesce import Flusher
     from rosl.graph.cache import GraphCache
     from rosl.graph.records import NodeRecord
     from rosl.node.lockstep import Answerer
@@ -64,6 +65,7 @@ class Participant:
         self._replayers: dict[str, list[Replayer]] = {}
         self.writers: list[Writer] = []  # the publishers' writers (lock-step answers list them)
         self.answerer: Answerer | None = None  # created when an executor first spins
+        self._flusher: Flusher | None = None  # created by the first coalescing publisher
         self.discovery = Discovery(self.transport, self.sender, self._describe)
         self.discovery.handlers["replay"] = self._on_replay_request
         self.discovery.handlers["typedef_request"] = self._on_typedef_request
@@ -260,10 +262,21 @@ class Participant:
                 pass
         return found
 
+    def flusher(self) -> Flusher:
+        """The thread that sends coalescing publishers' batches on time (started lazily)."""
+        with self._lock:
+            if self._flusher is None:
+                from rosl.bus.coalesce import Flusher
+
+                self._flusher = Flusher()
+            return self._flusher
+
     def close(self) -> None:
-        """Say goodbye and close every socket (idempotent)."""
+        """Send pending batches, say goodbye and close every socket (idempotent)."""
         if self.closed:
             return
+        if self._flusher is not None:
+            self._flusher.close()
         self.closed = True
         self.discovery.stop()
         self.wake()

@@ -1,8 +1,14 @@
-"""Publishers: serialize once, send on the topic's channel, keep history when transient-local."""
+"""Publishers: serialize once, send on the topic's channel, keep history when transient-local.
+
+``coalesce=True`` (or ``ROSL_COALESCE=1`` for every publisher of a process) sends small
+messages in batches of one datagram, at most a millisecond late: several times the messages
+per second of one datagram each, for streams of small messages (see ``rosl/bus/coalesce.py``).
+"""
 
 from __future__ import annotations
 
 import collections
+import os
 from typing import TYPE_CHECKING
 
 from rosl.bus.header import Kind
@@ -19,7 +25,14 @@ if TYPE_CHECKING:
 class Publisher:
     """Publishes messages of one type on one topic (rclpy.publisher.Publisher)."""
 
-    def __init__(self, node: Node, msg_type: type[Message], topic: str, qos: QoSProfile) -> None:
+    def __init__(
+        self,
+        node: Node,
+        msg_type: type[Message],
+        topic: str,
+        qos: QoSProfile,
+        coalesce: bool | None = None,
+    ) -> None:
         self.node = node
         self.msg_type = msg_type
         self.qos_profile = qos
@@ -31,6 +44,12 @@ class Publisher:
             participant.transport, participant.sender, self.endpoint, topic, self.type_name
         )
         participant.writers.append(self._writer)
+        if coalesce is None:
+            coalesce = os.environ.get("ROSL_COALESCE", "").strip().lower() in ("1", "true", "yes")
+        if coalesce:
+            from rosl.bus.coalesce import DEFAULT_BYTES
+
+            self._writer.coalesce(participant.flusher(), DEFAULT_BYTES)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
         self._history: collections.deque[tuple[int, int, bytes]] | None = (
@@ -81,6 +100,11 @@ class Publisher:
             PUBLISHER, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
             {"sent": self._writer.sent}, self.digest,
         )  # fmt: skip
+
+    def flush(self) -> None:
+        """Send the messages a coalescing publisher still holds (a no-op otherwise)."""
+        if self._writer.batch is not None:
+            self._writer.batch.flush()
 
     def destroy(self) -> None:
         """Stop publishing (rclpy: node.destroy_publisher)."""

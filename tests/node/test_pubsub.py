@@ -329,8 +329,9 @@ rosl.spin(node)
 
 
 def test_a_subscriber_logs_the_messages_it_lost_to_sequence_gaps(ros, spawn):
-    from rosl.bus.header import Kind
     from std_msgs.msg import String
+
+    from rosl.bus.header import Kind
 
     child = spawn(LISTENER)
     child.expect("^ready$")
@@ -349,3 +350,31 @@ def test_a_subscriber_logs_the_messages_it_lost_to_sequence_gaps(ros, spawn):
     assert "lost 2 message(s) on /gaps" in warning
     _, err = child.stop()
     assert err.count("lost ") == 1  # once, not once per message
+
+
+BURST = """
+import rosl
+from std_msgs.msg import String
+
+rosl.init()
+node = rosl.Node("burst_talker")
+pub = node.create_publisher(String, "burst", 1000)
+assert pub.wait_for_subscribers(1, 10.0) == 1
+for n in range(500):
+    pub.publish(String(data=str(n)))
+print("sent, coalescing:", pub._writer.batch is not None, flush=True)
+rosl.spin(node)
+"""
+
+
+def test_a_coalescing_publisher_delivers_every_message_in_order(ros, spawn):
+    from std_msgs.msg import String
+
+    node = ros.Node("burst_listener")
+    heard: list[str] = []
+    node.create_subscription(String, "burst", lambda m: heard.append(m.data), 1000)
+    child = spawn(BURST, env={"ROSL_COALESCE": "1"})
+    child.expect("^sent, coalescing: True$")
+    assert spin_until(node, lambda: len(heard) >= 500, 10.0), len(heard)
+    assert heard == [str(n) for n in range(500)]
+    assert node.subscriptions[0].lost == 0
