@@ -186,7 +186,7 @@ def _topics(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
         f"topic {name} has more than one type: {', '.join(types)}"
         for name, types in topics.items()
         if len(types) > 1
-    )
+    ) + _definition_clashes(graph)
     warnings = []
     for name in topics:
         if name in QUIET_TOPICS or is_hidden(name):
@@ -199,6 +199,22 @@ def _topics(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
     if mixed:
         return CheckResult("topic", False, "topic type mismatch", tuple(warnings), mixed)
     return CheckResult("topic", True, f"{len(topics)} topics, one type each", tuple(warnings))
+
+
+def _definition_clashes(graph: GraphCache) -> tuple[str, ...]:
+    """Topics whose endpoints read one type name from different .msg files."""
+    digests: dict[tuple[str, str], dict[str, list[str]]] = {}
+    for kind in (PUBLISHER, SUBSCRIPTION):
+        for node, endpoint in graph.endpoints(kind):
+            if endpoint.digest:
+                by_digest = digests.setdefault((endpoint.name, endpoint.type), {})
+                by_digest.setdefault(endpoint.digest, []).append(node.fqn)
+    return tuple(
+        f"topic {name}: {type_name} has {len(found)} different definitions "
+        f"({'; '.join(', '.join(sorted(set(nodes))) for nodes in found.values())})"
+        for (name, type_name), found in sorted(digests.items())
+        if len(found) > 1
+    )
 
 
 def _first(lines: tuple[str, ...]) -> tuple[str, ...]:

@@ -156,3 +156,41 @@ def test_report_prints_ros2_doctor_sections_with_padded_names(processes, domain_
     at = topics.index("topic               : /chatter")
     assert topics[at + 1 : at + 3] == ["publisher count     : 1", "subscriber count    : 0"]
     assert "All 6 checks passed" in out
+
+
+READING = """
+import sys
+import rosl
+from defs_pkg.msg import Reading
+
+rosl.init([])
+node = rosl.Node(sys.argv[1])
+if sys.argv[2] == "pub":
+    node.create_publisher(Reading, "/reading", 10)
+else:
+    node.create_subscription(Reading, "/reading", lambda m: None, 10)
+print("ready", flush=True)
+rosl.spin(node)
+rosl.shutdown()
+"""
+
+
+def test_one_type_read_from_two_different_msg_files_fails_the_topic_check(
+    processes, tmp_path: Path
+) -> None:
+    paths = {}
+    for folder, field in (("old", "int64"), ("new", "float64")):
+        write_package(tmp_path / folder, "defs_pkg", {"msg/Reading.msg": f"{field} value\n"})
+        paths[folder] = {"ROSL_PACKAGE_PATH": str(tmp_path / folder)}
+    for name, role, folder in (("old_talker", "pub", "old"), ("new_listener", "sub", "new")):
+        Watched(processes.python(READING, name, role, env=paths[folder])).wait_ready()
+    result = run(processes)
+    assert result.code == 1, result.out
+    assert (
+        "topic /reading: defs_pkg/msg/Reading has 2 different definitions "
+        "(/old_talker; /new_listener)"
+        in result.out
+        or "topic /reading: defs_pkg/msg/Reading has 2 different definitions "
+        "(/new_listener; /old_talker)"
+        in result.out
+    ), result.out
