@@ -197,4 +197,21 @@ def unknown_package_message(name: str, result: SearchResult) -> str:
     from rosl.idl.names import did_you_mean
 
     where = ", ".join(str(root) for root, _, _ in result.roots if root.is_dir())
-    return f"package '{name}' not found{did_you_mean(name, set(result.packages))}; searched {where}"
+    text = f"package '{name}' not found{did_you_mean(name, set(result.packages))}; searched {where}"
+    elsewhere = _in_another_workspace(name)
+    if elsewhere is not None:
+        src = elsewhere.parent
+        text += (
+            f"; it is in {elsewhere}, a workspace not active here: run rosl from inside "
+            f"{src.parent} or export ROSL_PACKAGE_PATH={src}"
+        )
+    return text
+
+
+def _in_another_workspace(name: str) -> Path | None:
+    """``~/<workspace>/src/<name>`` when such a package exists (the seed's ``~/ros2_ws``)."""
+    try:
+        candidates = sorted(Path.home().glob(f"*/src/{name}/{MANIFEST}"))
+    except (OSError, RuntimeError):  # no home, or one rosl may not read
+        return None
+    return candidates[0].parent if candidates else None

@@ -22,6 +22,13 @@ def find_executable(package: str, name: str) -> Executable:
         if executable.name == name:
             return executable
     names = [e.name for e in pkg.executables]
+    module = pkg.path / package / f"{name}.py"
+    if module.is_file():  # the seed's pain: written, but never registered
+        raise PackageError(
+            f"no executable '{name}' in package '{package}': {module} exists but is not "
+            f'declared; add <executable name="{name}">{package}.{name}:main</executable> '
+            f"under <export><rosl> in {pkg.manifest}"
+        )
     if not names:
         raise PackageError(
             f"package '{package}' declares no executables; declare them in "

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from tests.conftest import write_package
 from tests.launch.support import one_error_line
 
 if TYPE_CHECKING:
@@ -189,3 +190,43 @@ def test_run_domain_id_option_is_checked_like_the_environment(rosl: Rosl) -> Non
 
     assert code == 1
     assert one_error_line(err) == "--domain-id=300 is out of range: domain ids go from 0 to 232"
+
+
+def test_run_of_a_module_that_was_never_declared_says_how_to_declare_it(
+    rosl: Rosl, make_package: Callable[..., Path]
+) -> None:
+    # the seed wrote velocity_controller but forgot to register it (add_executable/install)
+    folder = make_package(
+        "forgetful_pkg", {"forgetful_pkg/__init__.py": "", "forgetful_pkg/controller.py": ""}
+    )
+    code, _, err = rosl.run("run", "forgetful_pkg", "controller")
+
+    assert code == 1
+    assert one_error_line(err) == (
+        "no executable 'controller' in package 'forgetful_pkg': "
+        f"{folder / 'forgetful_pkg' / 'controller.py'} exists but is not declared; add "
+        '<executable name="controller">forgetful_pkg.controller:main</executable> under '
+        f"<export><rosl> in {folder / 'package.xml'}"
+    )
+
+
+def test_run_from_outside_the_workspace_names_the_workspace_that_has_the_package(
+    rosl: Rosl, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the seed's "Package 'tutorial_pkg' not found" in a fresh terminal: no source to forget,
+    # but a terminal outside ~/ros2_ws does not see it; say so in the one line
+    home = tmp_path / "home"
+    write_package(home / "ros2_ws" / "src", "seed_pkg")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(elsewhere)
+
+    code, _, err = rosl.run("run", "seed_pkg", "talker")
+
+    assert code == 1
+    src = home / "ros2_ws" / "src"
+    assert one_error_line(err).endswith(
+        f"; it is in {src / 'seed_pkg'}, a workspace not active here: run rosl from inside "
+        f"{home / 'ros2_ws'} or export ROSL_PACKAGE_PATH={src}"
+    )
