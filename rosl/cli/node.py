@@ -20,7 +20,12 @@ def command() -> None:
     "-a", "--all", "include_hidden", is_flag=True, help="Display all nodes even hidden ones"
 )
 @click.option(
-    "-c", "--count-nodes", "count", is_flag=True, help="Only display the number of nodes discovered"
+    "-c",
+    "--count-nodes",
+    "--count",
+    "count",
+    is_flag=True,
+    help="Only display the number of nodes discovered",
 )
 @domain_option
 def list_(include_hidden: bool, count: bool, domain_id: int | None) -> None:

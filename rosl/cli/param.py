@@ -7,10 +7,20 @@ from pathlib import Path
 import click
 
 from rosl.cli import render
-from rosl.cli.options import domain_option
-from rosl.errors import RoslError
+from rosl.cli.options import GreedyOption, domain_option
 from rosl.introspection import params
+from rosl.introspection.errors import IntrospectionError
 from rosl.introspection.session import Session
+
+
+def _report(outcomes: list[params.Outcome]) -> int:
+    """Print ros2's result lines (failures on stderr); 1 if any failed."""
+    for ok, line in outcomes:
+        if ok:
+            render.lines([line])
+        else:
+            render.warn(line)
+    return 0 if all(ok for ok, _ in outcomes) else 1
 
 
 @click.group("param")
@@ -24,7 +34,14 @@ def command() -> None:
     "--filter",
     "filter_regex",
     default=None,
-    help="Only list parameters matching this regular expression",
+    help="Only parameters matching the regex expression will be showed (re.match)",
+)
+@click.option(
+    "--param-prefixes",
+    cls=GreedyOption,
+    multiple=True,
+    metavar="PREFIX...",
+    help="Only list parameters with the provided prefixes",
 )
 @click.option("--param-type", is_flag=True, help="Print parameter types with parameter names")
 @click.option(
@@ -34,6 +51,7 @@ def command() -> None:
 def list_(
     node_name: str | None,
     filter_regex: str | None,
+    param_prefixes: tuple[str, ...],
     param_type: bool,
     include_hidden: bool,
     domain_id: int | None,
@@ -45,6 +63,7 @@ def list_(
                 session,
                 node_name,
                 filter_regex=filter_regex,
+                prefixes=list(param_prefixes),
                 param_type=param_type,
                 include_hidden=include_hidden,
             )
@@ -62,21 +81,27 @@ def get(node_name: str, parameter_name: str, hide_type: bool, domain_id: int | N
         render.text(params.get(session, node_name, parameter_name, hide_type=hide_type) + "\n")
 
 
-@command.command("set")
+@command.command("set", context_settings={"ignore_unknown_options": True})
 @click.argument("node_name")
 @click.argument("pairs", nargs=-1, required=True, metavar="NAME VALUE [NAME VALUE ...]")
 @click.option("--atomic", is_flag=True, help="Set all parameters or none")
 @domain_option
-def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | None) -> None:
-    """Set parameter(s); values are YAML (1 int, 1.0 double, true bool, '[1, 2]' array)."""
+def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | None) -> int:
+    """Set parameter(s); values are YAML (1 int, 1.0 double, -1.0, true bool, '[1, 2]')."""
+    # unknown options are kept as arguments so that negative values (-1.0) stay values
+    for name in pairs[::2]:
+        if name.startswith("-"):
+            raise click.NoSuchOption(name)
     if len(pairs) % 2:
-        raise click.UsageError("give parameters as NAME VALUE pairs")
-    with Session(domain_id) as session:
-        render.lines(
-            params.set_values(
-                session, node_name, list(zip(pairs[::2], pairs[1::2], strict=True)), atomic=atomic
-            )
+        raise IntrospectionError(
+            "Parameters must be provided as name/value pairs: name value [name value ...]. "
+            f"Got {len(pairs)} argument(s)."
         )
+    with Session(domain_id) as session:
+        outcomes = params.set_values(
+            session, node_name, list(zip(pairs[::2], pairs[1::2], strict=True)), atomic=atomic
+        )
+    return _report(outcomes)
 
 
 @command.command("delete")
@@ -123,15 +148,13 @@ def dump(node_name: str, output_dir: Path | None, print_: bool, domain_id: int |
 @click.argument("node_name")
 @click.argument("parameter_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
-    "--no-use-wildcard", is_flag=True, help="Do not load parameters in the '/**' namespace"
+    "--no-use-wildcard",
+    is_flag=True,
+    help="Do not load parameters in the '/**' namespace into the node",
 )
 @domain_option
 def load(node_name: str, parameter_file: Path, no_use_wildcard: bool, domain_id: int | None) -> int:
     """Load parameter file for a node."""
     with Session(domain_id) as session:
-        results = params.load(session, node_name, parameter_file, use_wildcard=not no_use_wildcard)
-    for ok, line in results:
-        (render.text if ok else render.warn)(line + ("\n" if ok else ""))
-    if not all(ok for ok, _ in results):
-        raise RoslError("some parameters were not set")
-    return 0
+        outcomes = params.load(session, node_name, parameter_file, use_wildcard=not no_use_wildcard)
+    return _report(outcomes)

@@ -85,6 +85,8 @@ class Channel:
     sources: tuple[str, ...]  # node names: publishers or clients
     sinks: tuple[str, ...]  # node names: subscribers or servers
     marks: tuple[str, ...] = ()
+    unseen_sources: int = 0  # sources / sinks that a filter took out of the picture
+    unseen_sinks: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -186,7 +188,9 @@ def _filtered(model: GraphModel, options: GraphOptions) -> GraphModel:
         sources = tuple(n for n in c.sources if n in nodes)
         sinks = tuple(n for n in c.sinks if n in nodes)
         if sources or sinks:  # a channel whose every node was filtered out is not drawn
-            kept.append(replace(c, sources=sources, sinks=sinks))
+            unseen = (len(c.sources) - len(sources), len(c.sinks) - len(sinks))
+            kept.append(replace(c, sources=sources, sinks=sinks, unseen_sources=unseen[0],
+                                unseen_sinks=unseen[1]))  # fmt: skip
     return GraphModel(nodes, tuple(kept))
 
 
@@ -209,8 +213,27 @@ def _q(*lines: str) -> str:
 
 def _loose_ends(m: GraphModel, node: str) -> list[str]:
     """In nodes-only pictures: the node's topics that lead nowhere, so they stay visible."""
-    out = [f"-> {c.name}{_marks(c)}" for c in m.topics if node in c.sources and not c.sinks]
-    return out + [f"<- {c.name}{_marks(c)}" for c in m.topics if node in c.sinks and not c.sources]
+    out = [
+        f"-> {c.name}{_marks(c)}{_unseen(c.unseen_sinks)}"
+        for c in m.topics
+        if node in c.sources and not c.sinks
+    ]
+    return out + [
+        f"<- {c.name}{_marks(c)}{_unseen(c.unseen_sources)}"
+        for c in m.topics
+        if node in c.sinks and not c.sources
+    ]
+
+
+def _unseen(count: int) -> str:
+    return f" ({count} filtered out)" if count else ""
+
+
+def _across(names: tuple[str, ...], unseen: int, none: str) -> str:
+    """Who is across a channel: the names shown, and how many a filter left out."""
+    if not unseen:
+        return ", ".join(names) or none
+    return ", ".join([*names, f"{'+' if names else ''}{unseen} filtered out"])
 
 
 def _marks(channel: Channel) -> str:
@@ -310,7 +333,7 @@ def to_text(m: GraphModel) -> str:
             if rows:
                 out.append(f"  {title}:")
             for c in rows:
-                other = ", ".join(getattr(c, theirs)) or none
+                other = _across(getattr(c, theirs), getattr(c, f"unseen_{theirs}"), none)
                 out.append(f"    {c.name} [{', '.join(c.types)}] {arrow} {other}{_marks(c)}")
     return "\n".join(out) + "\n"
 

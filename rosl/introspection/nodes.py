@@ -21,9 +21,9 @@ def list_nodes(
 ) -> tuple[list[str], list[str]]:
     """(stdout lines, stderr lines) of ``ros2 node list``."""
     names = [n.fqn for n in session.graph().nodes() if visible(n.fqn, include_hidden)]
-    warnings = [DUPLICATE_WARNING] if len(set(names)) != len(names) else []
     if count:
-        return [str(len(names))], warnings
+        return [str(len(names))], []
+    warnings = [DUPLICATE_WARNING] if len(set(names)) != len(names) else []
     return sorted(names), warnings
 
 

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import fnmatch
 import re
 from typing import TYPE_CHECKING, Any
 
+from rosl.errors import RoslError
+from rosl.idl.names import did_you_mean
 from rosl.introspection.errors import IntrospectionError
 from rosl.node.parameters import Parameter, ParameterType, value_from_msg
 
@@ -25,6 +28,7 @@ _LABELS = {
     ParameterType.DOUBLE_ARRAY: "Double values are:",
     ParameterType.STRING_ARRAY: "String values are:",
 }
+Outcome = tuple[bool, str]  # (succeeded, ros2's line: stdout when it did, stderr when not)
 
 
 def _fqn(node: str) -> str:
@@ -33,6 +37,7 @@ def _fqn(node: str) -> str:
 
 def _call(session: Session, node: str, service: str, request_values: dict[str, Any]) -> Any:
     from rosl.idl.registry import get_service_class
+    from rosl.node.client import ServiceTimeoutError
 
     node = _fqn(node)
     session.find_node(node)
@@ -47,8 +52,6 @@ def _call(session: Session, node: str, service: str, request_values: dict[str, A
     request = srv.Request()
     for key, value in request_values.items():
         setattr(request, key, value)
-    from rosl.node.client import ServiceTimeoutError
-
     try:
         return client.call(request, timeout_sec=TIMEOUT)
     except ServiceTimeoutError:
@@ -57,9 +60,9 @@ def _call(session: Session, node: str, service: str, request_values: dict[str, A
         ) from None
 
 
-def list_names(session: Session, node: str) -> list[str]:
-    """Parameter names of one node, sorted."""
-    response = _call(session, node, "list_parameters", {})
+def list_names(session: Session, node: str, prefixes: list[str] | None = None) -> list[str]:
+    """Parameter names of one node (only under ``prefixes`` when given), sorted."""
+    response = _call(session, node, "list_parameters", {"prefixes": list(prefixes or [])})
     return sorted(response.result.names)
 
 
@@ -69,39 +72,66 @@ def types_of(session: Session, node: str, names: list[str]) -> list[ParameterTyp
     return [ParameterType(int(t)) for t in response.types]
 
 
+def _unknown(session: Session, node: str, names: list[str]) -> str:
+    """``'a' on /node (did you mean 'b'?)`` for parameters the node does not have."""
+    known = set(list_names(session, node))
+    hint = did_you_mean(names[0], known) if len(names) == 1 else ""
+    return f"{', '.join(names)} on {_fqn(node)}{hint}"
+
+
 def param_list(
     session: Session,
     node: str | None,
     *,
     filter_regex: str | None = None,
+    prefixes: list[str] | None = None,
     param_type: bool = False,
     include_hidden: bool = False,
 ) -> list[str]:
-    """The lines ``ros2 param list [NODE]`` prints."""
+    """The lines ``ros2 param list [NODE]`` prints.
+
+    As ros2 does: a ``/node:`` header only when no NODE was named, and only for nodes with
+    something to list; ``--filter`` keeps names the regex matches at their start (``re.match``).
+    """
     from rosl.introspection.session import visible
 
-    nodes = [_fqn(node)] if node else [
-        n.fqn for n in session.graph().nodes() if visible(n.fqn, include_hidden)
-        and session.graph().has_server(f"{n.fqn}/list_parameters")
-    ]  # fmt: skip
-    pattern = re.compile(filter_regex) if filter_regex else None
-    lines = []
-    for fqn in dict.fromkeys(nodes):
-        names = [n for n in list_names(session, fqn) if pattern is None or pattern.search(n)]
+    try:
+        pattern = re.compile(filter_regex) if filter_regex is not None else None
+    except re.error as err:
+        raise IntrospectionError(
+            f"bad --filter regular expression '{filter_regex}': {err}"
+        ) from None
+    if node:
+        nodes = [_fqn(node)]
+    else:
+        graph = session.graph()
+        found = {
+            n.fqn: (n.name, n.namespace) for n in graph.nodes()
+            if visible(n.fqn, include_hidden) and graph.has_server(f"{n.fqn}/list_parameters")
+        }  # fmt: skip
+        nodes = sorted(found, key=lambda fqn: found[fqn])  # ros2 sorts by (name, namespace)
+    lines: list[str] = []
+    for fqn in nodes:
+        names = list_names(session, fqn, prefixes)
+        names = [n for n in names if pattern is None or pattern.match(n)]
+        if not names:
+            continue
+        if not node:
+            lines.append(f"{fqn}:")
         kinds = types_of(session, fqn, names) if param_type else []
-        lines.append(f"{fqn}:")
         for index, name in enumerate(names):
-            suffix = f" (type: {kinds[index].word})" if param_type else ""
-            lines.append(f"  {name}{suffix}")
+            lines.append(f"  {name} (type: {kinds[index].word})" if param_type else f"  {name}")
     return lines
 
 
 def get(session: Session, node: str, name: str, *, hide_type: bool = False) -> str:
     """``ros2 param get``'s line, e.g. ``Double value is: 2.0``."""
     response = _call(session, node, "get_parameters", {"names": [name]})
-    kind, value = value_from_msg(response.values[0])
+    kind, value = (
+        value_from_msg(response.values[0]) if response.values else (ParameterType.NOT_SET, None)
+    )
     if kind is ParameterType.NOT_SET:
-        raise IntrospectionError(f"Parameter not set: {name} on {_fqn(node)}")
+        raise IntrospectionError(f"Parameter not set: {_unknown(session, node, [name])}")
     if kind is ParameterType.BYTE_ARRAY:
         value = list(value)
     text = str(value)
@@ -110,38 +140,61 @@ def get(session: Session, node: str, name: str, *, hide_type: bool = False) -> s
 
 def set_values(
     session: Session, node: str, pairs: list[tuple[str, str]], *, atomic: bool = False
-) -> list[str]:
-    """Set parameters (values parsed as YAML); return ros2's result lines.
+) -> list[Outcome]:
+    """Set parameters (values parsed as YAML); one outcome per ros2 result line.
 
-    Raises:
-        IntrospectionError: with ros2's "Setting parameter failed: reason" when refused.
+    With one parameter the lines are ros2's ``Set parameter successful`` / ``Setting parameter
+    failed: <reason>``; with several each is prefixed ``<name>: ``; ``--atomic`` gives one
+    ``Set parameters atomically successful`` / ``Setting parameters atomically failed`` line.
     """
-    from rosl.node.ros_args import parse_value
-
-    params = [Parameter(name, value=parse_value(text)).to_parameter_msg() for name, text in pairs]
+    params = [Parameter(name, value=_value(text)).to_parameter_msg() for name, text in pairs]
     if atomic:
         response = _call(session, node, "set_parameters_atomically", {"parameters": params})
-        results = [response.result]
-    else:
-        response = _call(session, node, "set_parameters", {"parameters": params})
-        results = list(response.results)
-    lines = []
-    for result in results:
+        result = response.result
+        word = "Set parameters atomically successful" if result.successful else (
+            "Setting parameters atomically failed"
+        )  # fmt: skip
+        return [(bool(result.successful), word + (f": {result.reason}" if result.reason else ""))]
+    response = _call(session, node, "set_parameters", {"parameters": params})
+    outcomes: list[Outcome] = []
+    declared: set[str] | None = None
+    for (name, _), result in zip(pairs, response.results, strict=True):
+        word = "Set parameter successful" if result.successful else "Setting parameter failed"
+        line = word + (f": {result.reason}" if result.reason else "")
         if not result.successful:
-            reason = f": {result.reason}" if result.reason else ""
-            raise IntrospectionError(f"Setting parameter failed{reason}")
-        lines.append("Set parameter successful" + (f": {result.reason}" if result.reason else ""))
-    return lines
+            declared = set(list_names(session, node)) if declared is None else declared
+            line += "" if name in declared else did_you_mean(name, declared)
+        outcomes.append((bool(result.successful), f"{name}: {line}" if len(pairs) > 1 else line))
+    return outcomes
+
+
+def _value(text: str) -> Any:
+    """A command-line value as ros2 reads it: YAML, else the text itself as a string."""
+    from rosl.node.ros_args import parse_value
+
+    value = parse_value(text)
+    try:
+        ParameterType.from_parameter_value(value)
+    except RoslError:
+        return text  # a mapping, a mixed list...: ros2 sets the string
+    return value
 
 
 def delete(session: Session, node: str, name: str) -> str:
-    """Delete (unset) a parameter."""
+    """Delete (unset) a parameter; ros2's ``Deleted parameter successfully``.
+
+    Raises:
+        IntrospectionError: ros2's ``Deleting parameter failed: <reason>``.
+    """
     param = Parameter(name, ParameterType.NOT_SET).to_parameter_msg()
     response = _call(session, node, "set_parameters", {"parameters": [param]})
     result = response.results[0]
+    reason = f": {result.reason}" if result.reason else ""
     if not result.successful:
-        raise IntrospectionError(f"Deleting parameter failed: {result.reason}")
-    return "Deleted parameter successfully"
+        known = set(list_names(session, node))
+        hint = "" if name in known else did_you_mean(name, known)
+        raise IntrospectionError(f"Deleting parameter failed{reason}{hint}")
+    return "Deleted parameter successfully" + reason
 
 
 def dump(session: Session, node: str) -> str:
@@ -174,39 +227,88 @@ def dump_to_dir(session: Session, node: str, directory: Path) -> Path:
     return path
 
 
-def load(
-    session: Session, node: str, path: Path, *, use_wildcard: bool = True
-) -> list[tuple[bool, str]]:
-    """Apply a parameter file to a running node; (ok, line) per parameter."""
-    from rosl.node.errors import RosArgsError
-    from rosl.node.ros_args import params_from_file
+def file_values(path: Path, node: str, *, use_wildcard: bool = True) -> dict[str, Any]:
+    """One node's parameters from a parameter file, as ``ros2 param load`` picks them.
 
+    The node's own section (``/node`` or ``node``) always applies; with ``use_wildcard`` the
+    wildcard sections (``/**``, ``/**/node``...) apply first, so the node's own values win.
+
+    Raises:
+        IntrospectionError: the file is not YAML, not a parameter file, or has nothing for node.
+    """
+    import yaml
+
+    fqn = _fqn(node)
     try:
-        values = params_from_file(path, _fqn(node))
-        if not use_wildcard:
-            exact = params_from_file(path, _fqn(node))
-            values = {k: v for k, v in exact.items()}
-    except RosArgsError as err:
-        raise IntrospectionError(str(err)) from None
-    if not values:
-        raise IntrospectionError(f"{path} has no parameters for {_fqn(node)}")
-    params = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]
-    response = _call(session, node, "set_parameters", {"parameters": params})
-    lines = []
-    for name, result in zip(values, response.results, strict=True):
-        if result.successful:
-            lines.append((True, f"Set parameter {name} successful"))
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
+        raise IntrospectionError(f"{where}: not a readable YAML parameter file") from None
+    if not isinstance(data, dict):
+        raise IntrospectionError(f"{path}: a parameter file maps node names to ros__parameters")
+    wildcard: list[dict[str, Any]] = []
+    own: list[dict[str, Any]] = []
+    for key, section in data.items():
+        pattern = _fqn(str(key))
+        chosen: list[dict[str, Any]] | None = None
+        if "*" in pattern:
+            matched = pattern == "/**" or fnmatch.fnmatchcase(fqn, pattern.replace("**", "*"))
+            chosen = wildcard if use_wildcard and matched else None
+        elif pattern == fqn:
+            chosen = own
+        if chosen is None:
+            continue
+        if not isinstance(section, dict) or not isinstance(section.get("ros__parameters"), dict):
+            raise IntrospectionError(
+                f"{path}: section '{key}' needs a 'ros__parameters:' mapping under it"
+            )
+        chosen.append(section["ros__parameters"])
+    if not wildcard + own:
+        sections = ", ".join(str(k) for k in data) or "none"
+        raise IntrospectionError(
+            f"Param file {path} does not contain parameters for {fqn}, only for nodes: {sections}"
+        )
+    values: dict[str, Any] = {}
+    for params in wildcard + own:
+        values.update(_flatten(params))
+    return values
+
+
+def _flatten(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in params.items():
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{prefix}{key}."))
         else:
-            lines.append((False, f"Set parameter {name} failed: {result.reason}"))
-    return lines
+            flat[f"{prefix}{key}"] = value
+    return flat
+
+
+def load(session: Session, node: str, path: Path, *, use_wildcard: bool = True) -> list[Outcome]:
+    """Apply a parameter file to a running node; ros2's line per parameter."""
+    session.find_node(_fqn(node))  # as ros2: an unknown node first, then the file
+    values = file_values(path, node, use_wildcard=use_wildcard)
+    try:
+        params = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]
+    except RoslError as err:
+        raise IntrospectionError(f"{path}: {err}") from None
+    response = _call(session, node, "set_parameters", {"parameters": params})
+    outcomes: list[Outcome] = []
+    for name, result in zip(values, response.results, strict=True):
+        reason = f": {result.reason}" if result.reason else ""
+        word = "successful" if result.successful else "failed"
+        outcomes.append((bool(result.successful), f"Set parameter {name} {word}{reason}"))
+    return outcomes
 
 
 def describe(session: Session, node: str, names: list[str]) -> list[str]:
     """``ros2 param describe``'s lines."""
     response = _call(session, node, "describe_parameters", {"names": names})
-    if not response.descriptors:
-        raise IntrospectionError(f"Parameter not declared: {', '.join(names)} on {_fqn(node)}")
-    lines = []
+    missing = [n for n in names if n not in {d.name for d in response.descriptors}]
+    if missing:
+        raise IntrospectionError(f"Parameter not declared: {_unknown(session, node, missing)}")
+    lines: list[str] = []
     for descriptor in response.descriptors:
         lines += [
             f"Parameter name: {descriptor.name}",
@@ -217,10 +319,14 @@ def describe(session: Session, node: str, names: list[str]) -> list[str]:
         lines.append("  Constraints:")
         if descriptor.read_only:
             lines.append("    Read only: true")
-        for rng in descriptor.floating_point_range or descriptor.integer_range:
-            lines += [f"    Min value: {rng.from_value}", f"    Max value: {rng.to_value}"]
-            if rng.step:
-                lines.append(f"    Step: {rng.step}")
+        ranges = [*descriptor.floating_point_range, *descriptor.integer_range]
+        if ranges:
+            lines += [
+                f"    Min value: {ranges[0].from_value}",
+                f"    Max value: {ranges[0].to_value}",
+            ]
+            if ranges[0].step:
+                lines.append(f"    Step: {ranges[0].step}")
         if descriptor.additional_constraints:
             lines.append(f"    Additional constraints: {descriptor.additional_constraints}")
     return lines

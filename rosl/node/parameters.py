@@ -421,8 +421,16 @@ class ParameterStore:
         if desc.read_only:
             return SetResult(False, f"Trying to set a read-only parameter: {name}."), param
         current = self._values[name]
-        if param.type_ is ParameterType.NOT_SET:
-            return SetResult(True), param  # deletion
+        if param.type_ is ParameterType.NOT_SET:  # deletion (rclpy's rules and words)
+            if not desc.dynamic_typing:
+                return SetResult(False, "Static parameter cannot be undeclared"), param
+            return SetResult(True), param
+        if not (desc.dynamic_typing or _same_kind(current.type_, param)):
+            return SetResult(
+                False,
+                f"Wrong parameter type, expected 'Type.{current.type_.name}' "
+                f"got 'Type.{param.type_.name}'",
+            ), param
         try:
             kind, value = _coerce(name, current.type_, param.type_, param.value, desc)
         except InvalidParameterTypeException as err:
@@ -465,6 +473,17 @@ class ParameterStore:
             if not low <= value <= high or (step and (value - low) % step):
                 return f"Parameter {{{param.name}}} doesn't comply with integer range."
         return ""
+
+
+def _same_kind(declared: ParameterType, param: Parameter) -> bool:
+    """Whether a set keeps a statically typed parameter's type (as rclpy checks it).
+
+    An empty list reads as a string array; it may empty any array parameter.
+    """
+    if declared in (param.type_, ParameterType.NOT_SET):
+        return True
+    empty = param.type_ is ParameterType.STRING_ARRAY and not param.value
+    return empty and "ARRAY" in declared.name
 
 
 def _coerce(

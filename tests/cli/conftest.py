@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -16,6 +17,9 @@ from rosl.idl import registry
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+
+    from rosl.graph.cache import GraphCache
+    from tests.conftest import Processes
 
 
 @dataclass(frozen=True)
@@ -76,3 +80,33 @@ def rosl_process() -> Callable[..., Result]:
         return Result(done.returncode, done.stdout, done.stderr)
 
     return run
+
+
+def run_rosl(processes: Processes, *args: str, timeout: float = 30.0) -> Result:
+    """Run the real ``rosl ARGS`` on the test's domain, piped (ROS 2's plain text); bounded."""
+    child = processes.rosl(*args, env={"NO_COLOR": "1"})
+    out, err = child.communicate(timeout=timeout)
+    return Result(child.returncode, out, err)
+
+
+def run(processes: Processes, *args: str, timeout: float = 30.0) -> Result:
+    """Run the real ``rosl ARGS`` on the test's domain, piped (ROS 2's plain text); bounded."""
+    child = processes.rosl(*args, env={"NO_COLOR": "1"})
+    out, err = child.communicate(timeout=timeout)
+    return Result(child.returncode, out, err)
+
+
+def timed(processes: Processes, *args: str) -> tuple[Result, float]:
+    """:func:`run`, and how long it took in seconds."""
+    started = time.monotonic()
+    result = run(processes, *args)
+    return result, time.monotonic() - started
+
+
+def wait_graph(check: Callable[[GraphCache], bool], timeout: float = 10.0) -> None:
+    """Wait, from a bare participant that shows up nowhere, until the graph passes ``check``."""
+    from rosl.introspection.session import Session
+
+    with Session() as session:
+        graph = session.graph()
+        assert graph.wait_for(lambda: check(graph), timeout), [n.fqn for n in graph.nodes()]

@@ -152,6 +152,24 @@ def test_mermaid_and_text_show_the_same_connections(system, processes) -> None:
     assert "    /cmd_vel [geometry_msgs/msg/Twist] -> nobody [dead sink, leaf]" in text.out
 
 
+def test_text_with_include_says_how_many_readers_were_filtered_out_not_nobody(
+    system, processes
+) -> None:
+    text = run(processes, "graph", "--text", "--include", "talker", "--hide-params", "--hide-debug")
+    assert text.code == 0, text.err
+    assert text.out == (
+        "/talker\n  publishes:\n    /chatter [std_msgs/msg/String] -> 1 filtered out\n"
+    )
+    both = run(processes, "graph", "--text", "--include", "^/(talker|listener)$", "--hide-debug")
+    assert "    /chatter [std_msgs/msg/String] -> /listener\n" in both.out
+    reader = run(processes, "graph", "--text", "--include", "scan_reader", "--hide-debug")
+    assert "    /scan [sensor_msgs/msg/LaserScan] <- 1 filtered out\n" in reader.out
+    nodes_only = dot_of(
+        processes, "--nodes-only", "--include", "talker", "--hide-debug", "--hide-params"
+    )
+    assert '"n:/talker" [label="/talker\\n-> /chatter (1 filtered out)", shape' in nodes_only
+
+
 def test_output_dot_file_is_written_and_stdout_stays_empty(
     system, processes, tmp_path: Path
 ) -> None:

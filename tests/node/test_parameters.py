@@ -7,10 +7,11 @@ import pytest
 
 from tests.node.helpers import spin_until
 
-WRONG_TYPE = (
+WRONG_TYPE = (  # an override at declaration (rcl's words)
     "Wrong parameter type, parameter {{{name}}} is of type {{{declared}}}, "
     "setting it to {{{given}}} is not allowed."
 )
+WRONG_TYPE_SET = "Wrong parameter type, expected 'Type.{declared}' got 'Type.{given}'"  # rclpy's
 
 
 def test_a_declared_parameter_has_its_default_when_nothing_overrides_it(ros):
@@ -123,12 +124,12 @@ def test_setting_a_parameter_to_another_type_is_refused_with_ros2s_text(ros):
     [result] = node.set_parameters([ros.Parameter("speed", value="fast")])
 
     assert not result.successful
-    assert result.reason == WRONG_TYPE.format(name="speed", declared="double", given="string")
+    assert result.reason == WRONG_TYPE_SET.format(declared="DOUBLE", given="STRING")
     assert node.get_parameter("speed").value == 1.5
-    # an int for a double is accepted and stored as a double
-    [ok] = node.set_parameters([ros.Parameter("speed", value=4)])
-    assert ok.successful
-    assert node.get_parameter("speed").value == 4.0
+    # an int for a double is refused too, as rclpy refuses it (an override at start is not)
+    [refused] = node.set_parameters([ros.Parameter("speed", value=4)])
+    assert refused.reason == WRONG_TYPE_SET.format(declared="DOUBLE", given="INTEGER")
+    assert node.get_parameter("speed").value == 1.5
     assert node.get_parameter("speed").type_ is ros.Parameter.Type.DOUBLE
 
 
@@ -210,7 +211,7 @@ def test_set_parameters_atomically_changes_all_or_nothing(ros):
         [ros.Parameter("a", value=10), ros.Parameter("b", value="not a double")]
     )
     assert not refused.successful
-    assert refused.reason == WRONG_TYPE.format(name="b", declared="double", given="string")
+    assert refused.reason == WRONG_TYPE_SET.format(declared="DOUBLE", given="STRING")
     assert node.get_parameter("a").value == 1
     assert node.get_parameter("b").value == 2.0
 
@@ -335,7 +336,7 @@ def test_another_process_reads_and_changes_parameters_through_the_services(ros, 
     )
     results = setter.call(request, timeout_sec=5.0).results
     assert [r.successful for r in results] == [True, False, False]
-    assert results[1].reason == WRONG_TYPE.format(name="mode", declared="string", given="integer")
+    assert results[1].reason == WRONG_TYPE_SET.format(declared="STRING", given="INTEGER")
     assert "read-only" in results[2].reason
     child.expect("^gain is 2.5$")
     again = client(GetParameters, "get_parameters").call(
