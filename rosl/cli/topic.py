@@ -65,9 +65,12 @@ def info(topic_name: str, verbose: bool, domain_id: int | None) -> None:
 @click.argument("topic_name")
 @domain_option
 def type_(topic_name: str, domain_id: int | None) -> None:
-    """Print a topic's type."""
+    """Print a topic's type (an unknown topic prints nothing and exits 1, as in ros2)."""
     with Session(domain_id) as session:
-        render.lines(session.topic_types(topic_name))
+        types = session.graph().topics().get(topic_name)
+    if not types:
+        raise click.exceptions.Exit(1)
+    render.lines(types)
 
 
 @command.command("find")

@@ -18,6 +18,7 @@ from rosl.introspection.errors import IntrospectionError
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
+    from rosl.graph.cache import GraphCache
     from rosl.introspection.session import Session
 
 DEFAULT_TRUNCATE = 128
@@ -42,15 +43,18 @@ class EchoOptions:
 
 def resolve_type(session: Session, topic: str, type_name: str | None) -> str:
     """The type to echo: the given one, else the topic's (which must be known and unique)."""
-    from rosl.idl.names import canonical
+    from rosl.idl.names import canonical, did_you_mean
 
     if type_name:
-        return canonical(type_name)
+        wanted = canonical(type_name)
+        check_published_type(session.graph(), topic, wanted)
+        return wanted
     topics = session.graph().topics()
     if topic not in topics:
         raise IntrospectionError(
-            f"WARNING: topic [{topic}] does not appear to be published yet; give its type "
-            f"to wait for it: rosl topic echo {topic} <pkg/msg/Type>"
+            f"WARNING: topic [{topic}] does not appear to be published yet"
+            f"{did_you_mean(topic, set(topics))}; give its type to wait for it: "
+            f"rosl topic echo {topic} <pkg/msg/Type>"
         )
     if len(topics[topic]) > 1:
         raise IntrospectionError(
@@ -58,6 +62,18 @@ def resolve_type(session: Session, topic: str, type_name: str | None) -> str:
             f"[{', '.join(topics[topic])}]"
         )
     return topics[topic][0]
+
+
+def check_published_type(graph: GraphCache, topic: str, wanted: str) -> None:
+    """Fail when ``topic`` has publishers and none of them publishes ``wanted``.
+
+    A topic nobody publishes yet passes: echo then waits for its first publisher.
+    """
+    published = sorted({e.type for _, e in graph.endpoints(PUBLISHER, topic)})
+    if published and wanted not in published:
+        raise IntrospectionError(
+            f"Cannot echo topic '{topic}' as {wanted}: it is published as {' and '.join(published)}"
+        )
 
 
 def select_field(message: Any, path: str | None) -> Any:
@@ -85,15 +101,27 @@ def compile_filter(expr: str | None) -> Any:
         ) from None
 
 
+def run_filter(check: Any, expr: str | None, value: Any) -> bool:
+    """Evaluate a compiled ``--filter`` on ``m = value``; a failure is the user's error.
+
+    Raises:
+        IntrospectionError: the expression raised (one line: expression, error type, text).
+    """
+    try:
+        return bool(eval(check, {"m": value}))
+    except Exception as err:  # any error of the user's expression is theirs to fix
+        raise IntrospectionError(f"--filter: {expr}: {type(err).__name__}: {err}") from None
+
+
 def render(value: Any, options: EchoOptions) -> str:
-    """One message (or selected field) as echo prints it, ending with ``---``."""
+    """One message (or selected field) as echo prints it: YAML and ``---``, or a CSV line."""
     from rosl.idl.yaml_io import dump_yaml, message_to_csv, message_to_yaml
 
     truncate = options.truncate_length
     if isinstance(value, Message):
-        if options.csv:
+        if options.csv:  # one line per message, no "---" (as ros2 prints it)
             return message_to_csv(value, truncate_length=truncate, no_arr=options.no_arr,
-                                  no_str=options.no_str) + "\n---"  # fmt: skip
+                                  no_str=options.no_str)  # fmt: skip
         text = message_to_yaml(
             value, truncate_length=truncate, no_arr=options.no_arr, no_str=options.no_str,
             flow_style=options.flow_style,
@@ -104,6 +132,19 @@ def render(value: Any, options: EchoOptions) -> str:
     if isinstance(value, list):
         return dump_yaml([_plain(v, truncate) for v in value]).rstrip("\n") + "\n---"
     return f"{value}\n---"
+
+
+def _texts(value: Any, info: dict[str, Any], options: EchoOptions) -> list[str]:
+    """What one received message prints: with ``-i``, its info first (or first in the CSV)."""
+    text = render(value, options)
+    if not options.include_info:
+        return [text]
+    if options.csv and isinstance(value, Message):
+        scalars = (v for v in info.values() if isinstance(v, (int, float, str)))
+        return [",".join(map(str, scalars)) + "," + text]  # ros2's four numbers, then the line
+    from rosl.idl.yaml_io import dump_yaml
+
+    return [dump_yaml(info).rstrip("\n") + "\n---", text]
 
 
 def _plain(value: Any, truncate: int | None) -> Any:
@@ -151,6 +192,8 @@ def echo(
     shown = 0
     lost_seen = 0
     while rosl.ok():
+        if type_name and not shown:  # a publisher that appears while we wait may not match
+            check_published_type(node.participant.graph, topic, resolved)
         executor.spin_once(timeout_sec=0.1)
         lost = subscription.lost
         if lost > lost_seen:
@@ -161,13 +204,9 @@ def echo(
             lost_seen = lost
         for message, info in inbox:
             value = select_field(message, options.field)
-            if check is not None and not eval(check, {"m": value}):
+            if check is not None and not run_filter(check, options.filter_expr, value):
                 continue
-            if options.include_info:
-                from rosl.idl.yaml_io import dump_yaml
-
-                yield dump_yaml(info).rstrip("\n") + "\n---"
-            yield render(value, options)
+            yield from _texts(value, info, options)
             shown += 1
             if options.once or (options.count is not None and shown >= options.count):
                 return

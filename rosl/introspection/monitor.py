@@ -6,7 +6,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from rosl.introspection import rates
-from rosl.introspection.echo import compile_filter
+from rosl.introspection.echo import compile_filter, run_filter
 from rosl.introspection.errors import IntrospectionError
 
 if TYPE_CHECKING:
@@ -38,7 +38,7 @@ def _decoder(session: Session, topic: str, expr: str) -> Any:
 
     def accept(delivery: Delivery) -> bool:
         message = serde.deserialize(delivery.payload, type_name)
-        return bool(eval(check, {"m": message}))
+        return run_filter(check, expr, message)
 
     return accept
 

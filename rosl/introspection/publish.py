@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.idl.errors import FieldError
 from rosl.introspection.errors import IntrospectionError
+from rosl.introspection.session import describe_value
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -60,13 +61,53 @@ def expand_specials(cls: type[Message], values: Any, now_ns: int) -> Any:
 
 
 def build(cls: type[Message], values: Any) -> Message:
-    """A message from YAML values (after special-value expansion)."""
+    """A message (or service request) from YAML values, after special-value expansion.
+
+    Shared by ``topic pub`` and ``service call`` so both accept and refuse the same values.
+
+    Raises:
+        IntrospectionError: ros2's "Failed to populate field: ..." naming the field and the
+            type it expects.
+    """
     from rosl.idl.messages import from_dict
 
     try:
+        check_strings(cls, values)
         return from_dict(cls, expand_specials(cls, copy.deepcopy(values), time.time_ns()))
     except FieldError as err:
         raise IntrospectionError(f"Failed to populate field: {err}") from None
+
+
+def check_strings(cls: type[Message], values: Any, path: str = "") -> None:
+    """Refuse a YAML number, bool or date given for a string field (``{folder_path: 5}``).
+
+    ros2 would send ``'5'``; a value meant as text must be quoted in YAML. Other field
+    types are checked by ``from_dict``.
+
+    Raises:
+        FieldError: the field's path and the expected type.
+    """
+    if not isinstance(values, dict):
+        return
+    for name, ftype in zip(cls._fields, cls._field_types, strict=True):
+        if name not in values:
+            continue
+        where = f"{path}.{name}" if path else name
+        value = values[name]
+        if ftype.is_array and not isinstance(value, list):
+            continue  # from_dict says a list is expected
+        items = (
+            [(f"{where}[{i}]", v) for i, v in enumerate(value)] if ftype.is_array
+            else [(where, value)]
+        )  # fmt: skip
+        for at, item in items:
+            if not ftype.is_primitive:
+                check_strings(cls._field_classes[name], item, at)
+            elif ftype.base == "string" and not isinstance(item, (str, dict, list, type(None))):
+                raise FieldError(
+                    f"{at}: expects a string, got {describe_value(item)} "
+                    f"(quote it to send text: '{item}')"
+                )
 
 
 def publish(
@@ -94,8 +135,10 @@ def publish(
     publisher = node.create_publisher(msg_type, topic, qos)
     limited = options.once or options.times > 0
     wait_for = options.wait_matching if options.wait_matching is not None else (1 if limited else 0)
+    wanted = msg_type.__msgtype__
+    yield from _check_subscription_types(session, node, topic, wanted, must_match=wait_for > 0)
     if wait_for > 0:
-        yield from _wait_subscribers(node, topic, wait_for, options.max_wait)
+        yield from _wait_subscribers(node, topic, wanted, wait_for, options.max_wait)
     yield ("out", "publisher: beginning loop")
     total = 1 if options.once else options.times
     count = 0
@@ -113,32 +156,61 @@ def publish(
         while rosl.ok() and time.monotonic() < next_at:
             rosl.spin_once(node, timeout_sec=max(0.0, min(0.1, next_at - time.monotonic())))
     if limited:
-        matched = session.participant.graph.count(SUBSCRIPTION, topic) - _own(node, topic)
+        matched, _ = _subscriptions(node, topic, wanted)
         yield ("err", f"sent {count} message(s) to {matched} matched subscription(s) on {topic}")
         end = time.monotonic() + options.keep_alive
         while time.monotonic() < end:
             rosl.spin_once(node, timeout_sec=max(0.0, end - time.monotonic()))
 
 
-def _own(node: Any, topic: str) -> int:
-    return sum(1 for s in node.subscriptions if s.topic == topic)
+def _subscriptions(node: Any, topic: str, wanted: str) -> tuple[int, list[str]]:
+    """(subscriptions of ``wanted`` on ``topic`` but our own, other types subscribed there)."""
+    own = node.get_fully_qualified_name()
+    endpoints = node.participant.graph.endpoints(SUBSCRIPTION, topic)
+    matched = sum(1 for n, e in endpoints if e.type == wanted and n.fqn != own)
+    return matched, sorted({e.type for _, e in endpoints if e.type != wanted})
+
+
+def _check_subscription_types(
+    session: Session, node: Any, topic: str, wanted: str, *, must_match: bool
+) -> Iterator[tuple[str, str]]:
+    """Refuse (when waiting for a match) or warn about subscriptions of another type.
+
+    They never receive what we send, so ros2 would wait forever for them to match.
+    """
+    session.graph(fresh=True)  # the node's view, complete
+    matched, others = _subscriptions(node, topic, wanted)
+    if not others:
+        return
+    if must_match and not matched:
+        raise IntrospectionError(
+            f"Cannot publish {wanted} on {topic}: its subscriptions expect {' and '.join(others)}"
+        )
+    yield (
+        "err",
+        f"WARNING: subscriptions on {topic} expecting {' and '.join(others)} will not receive "
+        f"these {wanted} messages",
+    )
 
 
 def _wait_subscribers(
-    node: Any, topic: str, wanted: int, bound: float
+    node: Any, topic: str, type_name: str, wanted: int, bound: float
 ) -> Iterator[tuple[str, str]]:
     graph = node.participant.graph
     deadline = time.monotonic() + bound
     announced = 0.0
-    while graph.count(SUBSCRIPTION, topic) < wanted:
+
+    def matched() -> int:
+        return _subscriptions(node, topic, type_name)[0]
+
+    while matched() < wanted:
         now = time.monotonic()
         if now >= deadline:
-            got = graph.count(SUBSCRIPTION, topic)
             raise IntrospectionError(
                 f"Timed out waiting for subscribers: Expected {wanted} subcribers but only got "
-                f"{got} subscribers (waited {bound:g} s on {topic}; nothing was published)"
+                f"{matched()} subscribers (waited {bound:g} s on {topic}; nothing was published)"
             )
         if now - announced >= 1.0:
             yield ("out", f"Waiting for at least {wanted} matching subscription(s)...")
             announced = now
-        graph.wait_for(lambda: graph.count(SUBSCRIPTION, topic) >= wanted, 0.1)
+        graph.wait_for(lambda: matched() >= wanted, 0.1)

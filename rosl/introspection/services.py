@@ -10,13 +10,13 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import CLIENT, SERVER
-from rosl.idl.errors import FieldError
 from rosl.introspection.errors import IntrospectionError
 from rosl.introspection.session import visible
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
 
+    from rosl.graph.cache import GraphCache
     from rosl.introspection.session import Session
 
 DEFAULT_TIMEOUT = 5.0
@@ -63,6 +63,23 @@ def resolve_service_type(session: Session, name: str, type_name: str | None) -> 
     return session.service_types(name)[0]
 
 
+def _check_served_type(graph: GraphCache, name: str, wanted: str) -> None:
+    """Fail at once when ``name`` is served, but only with other types than ``wanted``."""
+    served = sorted({e.type for _, e in graph.endpoints(SERVER, name)})
+    if served and wanted not in served:
+        raise IntrospectionError(f"service {name} is of type {' and '.join(served)}, not {wanted}")
+
+
+def _suggest(graph: GraphCache, name: str, wanted: str) -> str:
+    """``; did you mean '/x'?``: the closest served names, those of type ``wanted`` first."""
+    from rosl.idl.names import closest
+
+    servers = graph.endpoints(SERVER)
+    found = closest(name, {e.name for _, e in servers if e.type == wanted}, n=2)
+    found = found or closest(name, {e.name for _, e in servers}, n=2)
+    return "; did you mean " + " or ".join(f"'{c}'" for c in found) + "?" if found else ""
+
+
 def call(
     session: Session,
     name: str,
@@ -78,20 +95,24 @@ def call(
         IntrospectionError: bad type or values; the service is not there, or does not answer,
             within ``timeout`` seconds.
     """
-    from rosl.idl.messages import from_dict
     from rosl.idl.registry import get_service_class
+    from rosl.introspection.publish import build
     from rosl.node.client import ServiceTimeoutError
 
-    srv = get_service_class(resolve_service_type(session, name, type_name))
-    try:
-        request = from_dict(srv.Request, values)
-    except FieldError as err:
-        raise IntrospectionError(f"Failed to populate field: {err}") from None
+    wanted = resolve_service_type(session, name, type_name)
+    srv = get_service_class(wanted)
+    request = build(srv.Request, values)
+    _check_served_type(session.graph(), name, wanted)
     client = session.node().create_client(srv, name)
     if not client.service_is_ready():
         yield "waiting for service to become available..."
+        graph = client.node.participant.graph
         if not client.wait_for_service(timeout_sec=timeout):
-            raise IntrospectionError(f"service {name} not available after {timeout:g} s")
+            raise IntrospectionError(
+                f"service {name} not available after {float(timeout)} s"
+                f"{_suggest(graph, name, wanted)}"
+            )
+        _check_served_type(graph, name, wanted)
     while True:
         started = time.monotonic()
         yield f"requester: making request: {request!r}\n"
