@@ -22,9 +22,15 @@ from rosl.cli.options import domain_option
 @click.option(
     "--fixed-frame",
     "-f",
-    default="odom",
-    show_default=True,
-    help="The frame everything is drawn in (RViz's Fixed Frame)",
+    default=None,
+    help="The frame everything is drawn in (RViz's Fixed Frame)  [default: odom]",
+)
+@click.option(
+    "-d",
+    "--display-config",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="An RViz config (.rviz): its Fixed Frame is used (rviz2 -d FILE)",
 )
 @click.option(
     "--duration",
@@ -35,10 +41,18 @@ from rosl.cli.options import domain_option
 )
 @domain_option
 def command(
-    bag: Path | None, output: Path | None, fixed_frame: str, duration: float, domain_id: int | None
+    bag: Path | None,
+    output: Path | None,
+    fixed_frame: str | None,
+    display_config: Path | None,
+    duration: float,
+    domain_id: int | None,
 ) -> None:
     """Draw a bag (`rosl viz run1 -o path.png`) or the live system (`rosl viz -o now.png`)."""
     from rosl.introspection import viz
+
+    if fixed_frame is None:
+        fixed_frame = viz.rviz_fixed_frame(display_config) if display_config else "odom"
 
     if bag is not None:
         if not bag.exists():

@@ -161,6 +161,30 @@ class VizBuilder:
         return scene
 
 
+def rviz_fixed_frame(config: Path) -> str:
+    """The Fixed Frame an RViz config file (``rviz2 -d FILE``) names; ``odom`` if it names none.
+
+    Raises:
+        IntrospectionError: the file cannot be read or is not an RViz (YAML) config.
+    """
+    import yaml
+
+    from rosl.introspection.errors import IntrospectionError
+
+    try:
+        data = yaml.safe_load(config.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise IntrospectionError(f"{config}: cannot read: {err.strerror}") from None
+    except (yaml.YAMLError, UnicodeDecodeError):
+        raise IntrospectionError(f"{config}: not an RViz config (not YAML)") from None
+    manager = data.get("Visualization Manager") if isinstance(data, dict) else None
+    if not isinstance(manager, dict):
+        raise IntrospectionError(f"{config}: not an RViz config (no 'Visualization Manager')")
+    options = manager.get("Global Options")
+    frame = options.get("Fixed Frame") if isinstance(options, dict) else None
+    return str(frame) if frame else "odom"
+
+
 def from_bag(bag: Path, fixed_frame: str) -> VizBuilder:
     """Read the drawable topics of a bag (folder or .mcap file) in time order."""
     from rosl.bag.reader import iter_bag

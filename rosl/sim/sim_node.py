@@ -245,6 +245,7 @@ class SimNode:
             ]:
                 self.lockstep.mark(publisher.publisher)
         self.publish_static()
+        self._announce()
         self._wait_for_peers()
         if self.recorder is not None:  # the static messages, but nothing sent before the start
             self.recorder.record_at(0, lambda: True, only_from=participant.sender)
@@ -366,6 +367,25 @@ class SimNode:
             log=log,
         )
         self.recorder.start()
+
+    def _announce(self) -> None:
+        """One line on stderr when the world is up: the robots, their topics, the pace."""
+        options = self.options
+        pace = "lock-step" if options.fast else f"paced at {options.real_time_factor:g}x real time"
+        lines = []
+        for topics in self.robots:
+            spec = topics.sim_robot.robot.spec
+            prefix = f"/{spec.namespace}" if spec.namespace else ""
+            out = " ".join(
+                t.publisher.topic for t in (topics.odom, topics.joints, *topics.scans) if t
+            )
+            lines.append(f"{spec.name} drives on {prefix}/{spec.model.cmd_vel}, publishes {out}")
+        robots = "; ".join(lines)
+        until = f"for {options.duration:g} s" if options.duration is not None else "Ctrl-C to stop"
+        self._log(
+            f"[sim] {self.sim.world.name} is up ({pace}, {until}): {robots}; "
+            "and /tf /tf_static /clock"
+        )
 
     def _status(self, started: float) -> None:
         wall = time.monotonic() - started

@@ -29,7 +29,7 @@ def generate_launch_description():
                 executable="obstacle_avoidance",
                 name="obstacle_avoidance",
                 remappings=[("laser_scan", "/scan"), ("cmd_vel", "/cmd_vel")],
-            ros_arguments=["--log-level", "warn"],  # its "Distance is" line at 5 Hz: not here
+                ros_arguments=["--log-level", "warn"],  # its "Distance is" line at 5 Hz: not here
                 parameters=[
                     {
                         "use_sim_time": True,
