@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.idl.errors import FieldError
 from rosl.introspection.errors import IntrospectionError
-from rosl.introspection.session import describe_value
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -72,42 +71,9 @@ def build(cls: type[Message], values: Any) -> Message:
     from rosl.idl.messages import from_dict
 
     try:
-        check_strings(cls, values)
         return from_dict(cls, expand_specials(cls, copy.deepcopy(values), time.time_ns()))
     except FieldError as err:
         raise IntrospectionError(f"Failed to populate field: {err}") from None
-
-
-def check_strings(cls: type[Message], values: Any, path: str = "") -> None:
-    """Refuse a YAML number, bool or date given for a string field (``{folder_path: 5}``).
-
-    ros2 would send ``'5'``; a value meant as text must be quoted in YAML. Other field
-    types are checked by ``from_dict``.
-
-    Raises:
-        FieldError: the field's path and the expected type.
-    """
-    if not isinstance(values, dict):
-        return
-    for name, ftype in zip(cls._fields, cls._field_types, strict=True):
-        if name not in values:
-            continue
-        where = f"{path}.{name}" if path else name
-        value = values[name]
-        if ftype.is_array and not isinstance(value, list):
-            continue  # from_dict says a list is expected
-        items = (
-            [(f"{where}[{i}]", v) for i, v in enumerate(value)] if ftype.is_array
-            else [(where, value)]
-        )  # fmt: skip
-        for at, item in items:
-            if not ftype.is_primitive:
-                check_strings(cls._field_classes[name], item, at)
-            elif ftype.base == "string" and not isinstance(item, (str, dict, list, type(None))):
-                raise FieldError(
-                    f"{at}: expects a string, got {describe_value(item)} "
-                    f"(quote it to send text: '{item}')"
-                )
 
 
 def publish(
