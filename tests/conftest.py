@@ -11,7 +11,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import IO, TYPE_CHECKING
 
 import pytest
 
@@ -81,27 +81,32 @@ def make_package(workspace: Path) -> Callable[..., Path]:
 LOCK_DIR = Path("/tmp/rosl-test-domains")
 
 
-@pytest.fixture
-def domain_id(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
-    """A domain id no other test on this machine uses right now (locked by a file)."""
+def lock_domain() -> tuple[int, IO[str]]:
+    """A domain id no other test on this machine uses, and the open lock file holding it."""
     LOCK_DIR.mkdir(exist_ok=True)
     candidates = list(range(20, 233))
     random.shuffle(candidates)
     for domain in candidates:
-        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held for the test
+        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held by the caller
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             handle.close()
             continue
-        monkeypatch.setenv("ROSL_DOMAIN_ID", str(domain))
-        monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
-        try:
-            yield domain
-        finally:
-            handle.close()
-        return
+        return domain, handle
     pytest.fail("no free test domain id")
+
+
+@pytest.fixture
+def domain_id(monkeypatch: pytest.MonkeyPatch) -> Iterator[int]:
+    """A domain id no other test on this machine uses right now (locked by a file)."""
+    domain, handle = lock_domain()
+    monkeypatch.setenv("ROSL_DOMAIN_ID", str(domain))
+    monkeypatch.delenv("ROS_DOMAIN_ID", raising=False)
+    try:
+        yield domain
+    finally:
+        handle.close()
 
 
 class Processes:

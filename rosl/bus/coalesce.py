@@ -19,6 +19,8 @@ import struct
 import threading
 from typing import TYPE_CHECKING
 
+from rosl.errors import RoslError
+
 if TYPE_CHECKING:
     from collections.abc import Callable
 
@@ -49,11 +51,14 @@ class Batch:
         with self._lock:
             if len(self._records) + RECORD.size + len(payload) > self.limit:
                 self._flush_locked()
+            timed = True
             if self._first is None:
                 self._first = (seq, stamp)
-                self._flusher.due(self)
+                timed = self._flusher.due(self)
             self._records += RECORD.pack(seq, stamp, len(payload))
             self._records += payload
+            if not timed:  # the flusher has closed: nothing would send it later
+                self._flush_locked()
 
     def flush(self) -> None:
         """Send what is pending now."""
@@ -95,36 +100,42 @@ class Flusher:
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._closed = False
+        self.failed = 0  # batches the bus refused to send
 
-    def due(self, batch: Batch) -> None:
-        """Note that ``batch`` has a first message waiting."""
+    def due(self, batch: Batch) -> bool:
+        """Note that ``batch`` has a first message waiting; False once closed (send it now)."""
         with self._lock:
+            if self._stop.is_set():
+                return False
             self._due.append(batch)
-            if self._thread is None and not self._closed:
+            if self._thread is None:
                 self._thread = threading.Thread(target=self._run, name="rosl-coalesce", daemon=True)
                 self._thread.start()
         self._wake.set()
+        return True
 
     def flush(self) -> None:
-        """Send every pending batch now."""
+        """Send every pending batch now (a batch the network refused is counted, not kept)."""
         with self._lock:
             batches, self._due = self._due, []
         for batch in batches:
-            batch.flush()
+            try:
+                batch.flush()
+            except RoslError:  # the bus could not send: the writer's next send will say so
+                self.failed += 1
 
     def close(self) -> None:
-        """Send what is pending and stop the thread."""
-        self._closed = True
+        """Send what is pending and stop the thread; later batches go out at once."""
+        with self._lock:
+            self._stop.set()
         self.flush()
-        self._stop.set()
         self._wake.set()
         thread = self._thread
         if thread is not None and thread is not threading.current_thread():
             thread.join(timeout=1.0)
 
     def _run(self) -> None:
-        while not self._closed:
+        while not self._stop.is_set():
             self._wake.wait()
             self._wake.clear()
             if self._stop.wait(self.delay_s):

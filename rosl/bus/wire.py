@@ -95,9 +95,14 @@ class Writer:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
         self.batch = Batch(self._send_batch, min(limit, self.chunk), flusher)
 
+    def flush(self) -> None:
+        """Send the small messages a coalescing writer still holds."""
+        if self.batch is not None:
+            self.batch.flush()
+
     def _send_batch(self, seq: int, stamp: int, records: bytes) -> None:
         head = HEADER.pack(
-            _MAGIC, _VERSION, self.kind, self.flags | _BATCH, 1, self.sender, seq, self.topic,
+            _MAGIC, _VERSION, self.kind, _BATCH, 1, self.sender, seq, self.topic,
             self.type, 0, self.endpoint, len(records), stamp,
         )  # fmt: skip
         self.transport.send(self.channel, [head, records])
@@ -130,7 +135,7 @@ class Writer:
         kind_value = self.kind if kind is None else kind
         batch = self.batch
         if batch is not None:
-            if flags == self.flags and kind_value == self.kind and batch.fits(total):
+            if flags == 0 and kind_value == self.kind and batch.fits(total):  # plain, small
                 batch.add(number, when, payload)
                 self.sent += 1
                 if seq is None:
@@ -235,16 +240,11 @@ class Reader:
                     continue
                 address = ADDRESS.unpack_from(payload)
                 payload = memoryview(payload)[ADDRESS_SIZE:]
-            if kind == _DATA:  # the stream's sequence check, inline: it runs per message
+            if kind == _DATA:
                 stats = streams.get((sender, endpoint))
                 if stats is None:
                     stats = streams[(sender, endpoint)] = StreamStats(topic, last_seq=seq - 1)
-                step = (seq - stats.last_seq) & 0xFFFFFFFF
-                if 0 < step < 0x80000000:
-                    stats.lost += step - 1
-                    stats.last_seq = seq
-                stats.received += 1
-                stats.last_received = now
+                _advance(stats, seq, now)
             out.append(
                 _new_tuple(
                     Delivery,
@@ -288,26 +288,21 @@ class Reader:
             self.reassembler.malformed += 1
             return
         flags &= ~_BATCH
+        stats = None
+        if kind == _DATA and records:  # one publisher's stream: looked up once per batch
+            key = (sender, endpoint)
+            stats = self.streams.get(key)
+            if stats is None:
+                stats = self.streams[key] = StreamStats(topic, last_seq=records[0][0] - 1)
         for seq, stamp, payload in records:
-            if kind == _DATA:
-                self._count(sender, endpoint, topic, seq, now)
+            if stats is not None:
+                _advance(stats, seq, now)
             out.append(
-                Delivery(
-                    kind, sender, endpoint, seq, topic, type_, stamp, now, payload, None, flags
+                _new_tuple(
+                    Delivery,
+                    (kind, sender, endpoint, seq, topic, type_, stamp, now, payload, None, flags),
                 )
             )
-
-    def _count(self, sender: int, endpoint: int, topic: int, seq: int, now: int) -> None:
-        key = (sender, endpoint)
-        stats = self.streams.get(key)
-        if stats is None:
-            stats = self.streams[key] = StreamStats(topic, last_seq=seq - 1)
-        step = (seq - stats.last_seq) & 0xFFFFFFFF
-        if 0 < step < 0x80000000:
-            stats.lost += step - 1
-            stats.last_seq = seq
-        stats.received += 1
-        stats.last_received = now
 
     def lost(self, topic: int | None = None) -> int:
         """Messages lost (sequence gaps) on all streams, or on one topic's streams."""
@@ -316,3 +311,13 @@ class Reader:
     def received(self, topic: int | None = None) -> int:
         """Messages received on all streams, or on one topic's streams."""
         return sum(s.received for s in self.streams.values() if topic is None or s.topic == topic)
+
+
+def _advance(stats: StreamStats, seq: int, now: int) -> None:
+    """Count one message of a stream, and the gap before it (loss is never silent)."""
+    step = (seq - stats.last_seq) & 0xFFFFFFFF
+    if 0 < step < 0x80000000:
+        stats.lost += step - 1
+        stats.last_seq = seq
+    stats.received += 1
+    stats.last_received = now

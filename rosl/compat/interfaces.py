@@ -12,7 +12,6 @@ from typing import Any
 # imported up front: importing them from inside find_spec, while another module is half
 # imported (copy imports org.python.core), would re-enter that half-built module
 from rosl.idl import search_path
-from rosl.idl.errors import InterfaceError
 
 _KINDS = ("msg", "srv")
 _busy = threading.local()  # set while the finder itself imports or scans
@@ -71,11 +70,8 @@ class _Loader(importlib.abc.Loader):
 
 
 def _is_interface_package(name: str) -> bool:
-    try:
-        folder = search_path.find_package(name).path
-    except InterfaceError:
-        return False
-    return any((folder / kind).is_dir() for kind in _KINDS)
+    found = search_path.scan().packages.get(name)  # a miss is common here: no error built
+    return found is not None and any((found.path / kind).is_dir() for kind in _KINDS)
 
 
 def _is_real(spec: importlib.machinery.ModuleSpec | None) -> bool:

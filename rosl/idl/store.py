@@ -116,13 +116,7 @@ class Store:
         Raises:
             InterfaceError: the schema cannot be read, or the bytes are not that type.
         """
-        key = (type_name, encoding, text)
-        with self._lock:
-            typestore = self._schemas.get(key)
-        if typestore is None:
-            typestore = _schema_typestore(type_name, encoding, text)
-            with self._lock:
-                typestore = self._schemas.setdefault(key, typestore)
+        typestore = self._schema_store(type_name, encoding, text)
         try:
             return typestore.deserialize_cdr(data, type_name)
         except Exception as err:  # rosbags raises several kinds for bytes that do not fit
@@ -144,6 +138,16 @@ class Store:
         Raises:
             InterfaceError: the schema cannot be read, or it does not define ``type_name``.
         """
+        typestore = self._schema_store(type_name, encoding, text)
+        try:
+            return typestore.hash_rihs01(type_name)
+        except Exception as err:  # rosbags raises several kinds for an incomplete definition
+            raise InterfaceError(
+                f"cannot hash {type_name} from its {encoding} schema: {type(err).__name__}: {err}"
+            ) from None
+
+    def _schema_store(self, type_name: str, encoding: str, text: str) -> Typestore:
+        """The type store of one recording's schema (made once per distinct schema)."""
         key = (type_name, encoding, text)
         with self._lock:
             typestore = self._schemas.get(key)
@@ -151,12 +155,7 @@ class Store:
             typestore = _schema_typestore(type_name, encoding, text)
             with self._lock:
                 typestore = self._schemas.setdefault(key, typestore)
-        try:
-            return typestore.hash_rihs01(type_name)
-        except Exception as err:  # rosbags raises several kinds for an incomplete definition
-            raise InterfaceError(
-                f"cannot hash {type_name} from its {encoding} schema: {type(err).__name__}: {err}"
-            ) from None
+        return typestore
 
     def fielddefs(self, type_name: str) -> Any:
         """Return rosbags' (constants, fields) entry for a registered type."""

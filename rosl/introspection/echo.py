@@ -184,6 +184,7 @@ def echo(
     subscription = node.create_subscription(
         msg_type, topic, lambda m, info: inbox.append((m, info)), qos
     )
+    subscription.log_loss = False  # echo says "A message was lost!!!" itself, as ros2 does
     import rosl
 
     executor = rosl.SingleThreadedExecutor()

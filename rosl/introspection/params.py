@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import fnmatch
 import re
 from typing import TYPE_CHECKING, Any
 
@@ -236,53 +235,13 @@ def file_values(path: Path, node: str, *, use_wildcard: bool = True) -> dict[str
     Raises:
         IntrospectionError: the file is not YAML, not a parameter file, or has nothing for node.
     """
-    import yaml
+    from rosl.node.errors import RosArgsError
+    from rosl.node.ros_args import params_from_file
 
-    fqn = _fqn(node)
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
-        raise IntrospectionError(f"{where}: not a readable YAML parameter file") from None
-    if not isinstance(data, dict):
-        raise IntrospectionError(f"{path}: a parameter file maps node names to ros__parameters")
-    wildcard: list[dict[str, Any]] = []
-    own: list[dict[str, Any]] = []
-    for key, section in data.items():
-        pattern = _fqn(str(key))
-        chosen: list[dict[str, Any]] | None = None
-        if "*" in pattern:
-            matched = pattern == "/**" or fnmatch.fnmatchcase(fqn, pattern.replace("**", "*"))
-            chosen = wildcard if use_wildcard and matched else None
-        elif pattern == fqn:
-            chosen = own
-        if chosen is None:
-            continue
-        if not isinstance(section, dict) or not isinstance(section.get("ros__parameters"), dict):
-            raise IntrospectionError(
-                f"{path}: section '{key}' needs a 'ros__parameters:' mapping under it"
-            )
-        chosen.append(section["ros__parameters"])
-    if not wildcard + own:
-        sections = ", ".join(str(k) for k in data) or "none"
-        raise IntrospectionError(
-            f"Param file {path} does not contain parameters for {fqn}, only for nodes: {sections}"
-        )
-    values: dict[str, Any] = {}
-    for params in wildcard + own:
-        values.update(_flatten(params))
-    return values
-
-
-def _flatten(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    flat: dict[str, Any] = {}
-    for key, value in params.items():
-        if isinstance(value, dict):
-            flat.update(_flatten(value, f"{prefix}{key}."))
-        else:
-            flat[f"{prefix}{key}"] = value
-    return flat
+        return params_from_file(path, _fqn(node), use_wildcard=use_wildcard, required=True)
+    except RosArgsError as err:
+        raise IntrospectionError(str(err)) from None
 
 
 def load(session: Session, node: str, path: Path, *, use_wildcard: bool = True) -> list[Outcome]:

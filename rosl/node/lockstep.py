@@ -88,6 +88,7 @@ class Answerer:
             )  # fmt: skip
             self._class = registry.get_message_class(TYPE)
         store = registry.store()
+        self.participant.flush()  # what the callbacks published goes out before the answer
         for source, handled in self.seen.items():
             if not (self._data or timers_ran or self._told.get(source) != next_wakeup):
                 continue  # only /clock ticks that woke nothing: the sim is not waiting

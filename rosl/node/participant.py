@@ -271,6 +271,11 @@ class Participant:
                 self._flusher = Flusher()
             return self._flusher
 
+    def flush(self) -> None:
+        """Send what coalescing publishers still hold (a no-op without any)."""
+        if self._flusher is not None:
+            self._flusher.flush()
+
     def close(self) -> None:
         """Send pending batches, say goodbye and close every socket (idempotent)."""
         if self.closed:

@@ -103,8 +103,7 @@ class Publisher:
 
     def flush(self) -> None:
         """Send the messages a coalescing publisher still holds (a no-op otherwise)."""
-        if self._writer.batch is not None:
-            self._writer.batch.flush()
+        self._writer.flush()
 
     def destroy(self) -> None:
         """Stop publishing (rclpy: node.destroy_publisher)."""

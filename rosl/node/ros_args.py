@@ -7,7 +7,7 @@ parameter files use ROS 2's layout (``/**`` or a node name, then ``ros__paramete
 
 from __future__ import annotations
 
-import fnmatch
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -180,17 +180,26 @@ def _log_level(text: str, result: RosArgs) -> None:
     result.log_levels[name] = level.lower()
 
 
-def params_from_file(path: Path, node_fqn: str) -> dict[str, Any]:
-    """Read one node's parameters from a ROS 2 parameter file (wildcards first).
+def params_from_file(
+    path: Path, node_fqn: str, *, use_wildcard: bool = True, required: bool = False
+) -> dict[str, Any]:
+    """Read one node's parameters from a ROS 2 parameter file (wildcard sections first).
+
+    Args:
+        path: the file.
+        node_fqn: the node's fully qualified name.
+        use_wildcard: let ``/**``-style sections apply (``ros2 param load --no-use-wildcard``).
+        required: a file with no section for the node is an error (``ros2 param load``).
 
     Raises:
-        RosArgsError: not YAML, or not in the ``node: {ros__parameters: {...}}`` layout.
+        RosArgsError: not YAML, not in the ``node: {ros__parameters: {...}}`` layout, or
+            (``required``) nothing for the node.
     """
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
     except OSError as err:
         raise RosArgsError(f"{path}: cannot read: {err.strerror}") from None
-    except yaml.YAMLError as err:
+    except (yaml.YAMLError, UnicodeDecodeError) as err:
         mark = getattr(err, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(path)
         problem = getattr(err, "problem", None) or "not YAML"
@@ -200,25 +209,35 @@ def params_from_file(path: Path, node_fqn: str) -> dict[str, Any]:
     matches: list[tuple[int, dict[str, Any]]] = []
     for key, section in data.items():
         pattern = str(key) if str(key).startswith("/") else "/" + str(key)
-        if not isinstance(section, dict) or "ros__parameters" not in section:
+        wildcard = "*" in pattern
+        if (wildcard and not use_wildcard) or not _node_matches(pattern, node_fqn):
+            continue
+        if not isinstance(section, dict) or not isinstance(section.get("ros__parameters"), dict):
             raise RosArgsError(
                 f"{path}: section '{key}' needs a 'ros__parameters:' mapping under it"
             )
-        if _node_matches(pattern, node_fqn):
-            specificity = 0 if "*" in pattern else 1
-            matches.append((specificity, section["ros__parameters"] or {}))
+        matches.append((0 if wildcard else 1, section["ros__parameters"]))
+    if required and not matches:
+        sections = ", ".join(str(k) for k in data) or "none"
+        raise RosArgsError(
+            f"Param file {path} does not contain parameters for {node_fqn}, "
+            f"only for nodes: {sections}"
+        )
     values: dict[str, Any] = {}
-    for _, params in sorted(matches, key=lambda m: m[0]):
+    for _, params in sorted(matches, key=lambda m: m[0]):  # the node's own section wins
         values.update(_flatten(params))
     return values
 
 
 def _node_matches(pattern: str, node_fqn: str) -> bool:
-    if pattern in ("/**", "/*"):
-        return True
-    if "*" in pattern:
-        return fnmatch.fnmatchcase(node_fqn, pattern.replace("**", "*"))
-    return pattern == node_fqn
+    """Rcl's rule: ``**`` matches any part of a name, ``*`` one token."""
+    if "*" not in pattern:
+        return pattern == node_fqn
+    regex = "".join(
+        ".*" if part == "**" else "[^/]*" if part == "*" else re.escape(part)
+        for part in re.split(r"(\*\*|\*)", pattern)
+    )
+    return re.fullmatch(regex, node_fqn) is not None
 
 
 def _flatten(params: dict[str, Any], prefix: str = "") -> dict[str, Any]:

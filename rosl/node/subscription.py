@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import inspect
 from collections import deque
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind, topic_hash, type_hash
@@ -21,7 +22,7 @@ from rosl.idl.errors import InterfaceError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from rosl.bus.wire import Delivery
+    from rosl.bus.wire import Delivery, StreamStats
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
@@ -41,6 +42,15 @@ def _wants_info(callback: Callable[..., Any]) -> bool:
     except (TypeError, ValueError):
         return False
     return len(params) >= 2
+
+
+@dataclass(slots=True)
+class _Peer:
+    """One publisher as a subscription sees it."""
+
+    agrees: bool | None  # same definition of the type; None while discovery has not told
+    generation: int  # the graph's generation when that was decided
+    stats: StreamStats | None  # its stream's sequence bookkeeping (loss)
 
 
 class Subscription:
@@ -70,9 +80,11 @@ class Subscription:
         self._with_info = _wants_info(callback)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
-        self._peers: dict[tuple[int, int], bool] = {}  # (process, endpoint) -> same definition
+        self._peers: dict[tuple[int, int], _Peer] = {}  # by (process, endpoint)
+        self._graph = participant.graph
         self._streams = participant.reader.streams  # sequence bookkeeping per publisher
         self._lost_told = 0  # the loss already reported in the log
+        self.log_loss = True  # False for tools that report loss in their own words (echo)
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
         self.received = 0
@@ -112,21 +124,23 @@ class Subscription:
             self._replayed.append(key)
         elif delivery.kind != _DATA:
             return
-        else:
-            if self.qos_profile.keeps_history:
-                self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
-            stream = self._streams.get((delivery.sender, delivery.endpoint))
-            if stream is not None and stream.lost and delivery.received >= self._lost_told_at:
-                self._tell_loss(delivery)
         if delivery.type != self._type_hash:
             self._mismatch(delivery)
             return
-        agrees = self._peers.get((delivery.sender, delivery.endpoint))
-        if agrees is None:
-            agrees = self._same_definition(delivery)
-        if not agrees:
+        key = (delivery.sender, delivery.endpoint)
+        peer = self._peers.get(key)
+        if peer is None or (peer.agrees is None and peer.generation != self._graph.generation):
+            peer = self._peers[key] = self._meet(delivery)
+        if peer.agrees is False:
             self.mismatched += 1
             return
+        if delivery.kind == _DATA:
+            if self.qos_profile.keeps_history:
+                self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
+            stats = peer.stats or self._streams.get(key)
+            peer.stats = stats
+            if stats is not None and stats.lost and delivery.received >= self._lost_told_at:
+                self._tell_loss(delivery)
         if self.raw:
             message: Any = bytes(delivery.payload)
         else:
@@ -170,7 +184,7 @@ class Subscription:
         """Log messages lost on this topic since the last report (at most every few seconds)."""
         lost = self.lost
         self._lost_told_at = delivery.received + LOSS_REPORT_EVERY_NS
-        if lost <= self._lost_told:
+        if lost <= self._lost_told or not self.log_loss:
             return
         self.node.get_logger().warn(
             f"lost {lost - self._lost_told} message(s) on {self.topic} (sequence gaps: the "
@@ -178,21 +192,26 @@ class Subscription:
         )
         self._lost_told = lost
 
-    def _same_definition(self, delivery: Delivery) -> bool:
-        """Whether the sending publisher reads the type as this process does (graph-checked)."""
-        for node, endpoint in self.node.participant.graph.endpoints(PUBLISHER, self.topic):
+    def _meet(self, delivery: Delivery) -> _Peer:
+        """What this subscription knows of a publisher, from the graph (once per change).
+
+        Whether it reads the type as this process does: a publisher discovery has not
+        announced yet is delivered, and asked about again when the graph changes.
+        """
+        generation = self._graph.generation
+        stats = self._streams.get((delivery.sender, delivery.endpoint))
+        for node, endpoint in self._graph.endpoints(PUBLISHER, self.topic):
             if node.process != delivery.sender or endpoint.endpoint != delivery.endpoint:
                 continue
             agrees = not endpoint.digest or not self.digest or endpoint.digest == self.digest
-            self._peers[(delivery.sender, delivery.endpoint)] = agrees
             if not agrees:
                 self.node.get_logger().warn(
                     f"subscription on {self.topic} expects {self.type_name} as this process's "
                     f".msg files define it, but {node.fqn} publishes another definition of it "
                     "(one of the two .msg files changed); dropped without decoding"
                 )
-            return agrees
-        return True  # not announced yet: nothing to compare with
+            return _Peer(agrees, generation, stats)
+        return _Peer(None, generation, stats)
 
     @property
     def lost(self) -> int:

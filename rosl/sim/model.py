@@ -15,6 +15,12 @@ if TYPE_CHECKING:
 Point = tuple[float, float]
 
 
+def signed_area(points: list[Point] | tuple[Point, ...]) -> float:
+    """Twice a polygon's signed area (positive when its points run counter-clockwise)."""
+    ring = list(points)
+    return sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(ring, ring[1:] + ring[:1], strict=True))
+
+
 @dataclass(frozen=True, slots=True)
 class Circle:
     """A circle obstacle (static or a dynamic body's shape)."""

@@ -3,10 +3,11 @@
 The command is clamped to the model's limits and ramped at its acceleration limit; each
 physics step sets the body's velocity from inside ``velocity_func``, so pymunk's contact
 solver still stops the robot at walls (writing velocities before ``step()`` would tunnel).
-A groove joint along the heading, moved before every step, is the wheels' grip: the solver
-cannot slide the robot sideways, so pushing on against an obstacle stalls it where it hit,
-as on Gazebo or a real floor. Odometry is the body's motion relative to its spawn pose, in
-the ``odom`` frame.
+A groove joint along the heading, moved before every step while the robot touches something,
+is the wheels' grip: the solver cannot slide the robot sideways, so pushing on against an
+obstacle stalls it where it hit, as on Gazebo or a real floor (driving free, the velocity
+function alone keeps it on its heading, and the joint costs nothing). Odometry is the body's
+motion relative to its spawn pose, in the ``odom`` frame.
 """
 
 from __future__ import annotations
@@ -43,9 +44,11 @@ class DiffDriveRobot:
         self.body.angle = spec.pose[2]
         self.shape = _pymunk_shape(self.body, foot, local=True)
         self.shape.friction = 0.0
+        space.add(self.body, self.shape)
         self.grip = pymunk.GrooveJoint(space.static_body, self.body, (0, 0), (1, 0), (0, 0))
-        space.add(self.body, self.shape, self.grip)
-        self.before_step(0.0)
+        self._space = space
+        self.contacts = 0  # obstacles touching the robot now (the simulation counts them)
+        self._gripping = False
         self.body.velocity_func = self._velocity
         self.target = (0.0, 0.0)
         self.v = 0.0
@@ -94,6 +97,11 @@ class DiffDriveRobot:
         pymunk moves the body first and solves the constraints after, so the groove goes
         where this step's motion takes the body, along the heading it will have there.
         """
+        if not self.contacts:
+            if self._gripping:
+                self._space.remove(self.grip)
+                self._gripping = False
+            return
         body = self.body
         x = body.position.x + body.velocity.x * dt
         y = body.position.y + body.velocity.y * dt
@@ -101,6 +109,9 @@ class DiffDriveRobot:
         dx, dy = GROOVE * math.cos(angle), GROOVE * math.sin(angle)
         self.grip.groove_a = (x - dx, y - dy)
         self.grip.groove_b = (x + dx, y + dy)
+        if not self._gripping:
+            self._space.add(self.grip)
+            self._gripping = True
 
     def after_step(self, dt: float) -> None:
         """Advance the wheel joints with the motion the solver allowed."""

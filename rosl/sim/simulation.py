@@ -94,7 +94,9 @@ class Simulation:
                     last_xy=spec.pose[:2],
                 )
             )
-        self.space.space.on_collision(ROBOT_COLLISION, None, begin=self._on_contact)
+        self.space.space.on_collision(
+            ROBOT_COLLISION, None, begin=self._on_contact, separate=self._on_parting
+        )
         self._by_shape = {r.robot.shape: r for r in self.robots}
         for sim_robot in self.robots:
             self._sample(sim_robot)
@@ -118,11 +120,21 @@ class Simulation:
 
     def _on_contact(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         del space, data
+        counted = False
         for shape in arbiter.shapes:
             hit = self._by_shape.get(shape)
             if hit is not None:
-                hit.collisions += 1
-                return
+                hit.robot.contacts += 1
+                if not counted:  # one collision, even between two robots
+                    hit.collisions += 1
+                    counted = True
+
+    def _on_parting(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        del space, data
+        for shape in arbiter.shapes:
+            hit = self._by_shape.get(shape)
+            if hit is not None:
+                hit.robot.contacts = max(0, hit.robot.contacts - 1)
 
     def sample(self) -> None:
         """Record each robot's pose for the path and its clearance (call at the odom rate)."""

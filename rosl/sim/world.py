@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pymunk
 
+from rosl.sim.model import signed_area
 from rosl.sim.worldfile import Circle, Polygon, RobotSpec, Segment, Shape
 
 if TYPE_CHECKING:
@@ -35,18 +36,11 @@ def _pymunk_shapes(body: pymunk.Body, shape: Shape) -> list[pymunk.Shape]:
         from pymunk.autogeometry import convex_decomposition
 
         points = list(shape.points)
-        if _area(points) < 0:
+        if signed_area(points) < 0:
             points.reverse()
         hulls = convex_decomposition([*points, points[0]], 0.0)
         return [pymunk.Poly(body, [tuple(p) for p in hull[:-1]]) for hull in hulls]
     return [_pymunk_shape(body, shape)]
-
-
-def _area(points: list[tuple[float, float]]) -> float:
-    """Twice the signed area (positive counter-clockwise)."""
-    return sum(
-        a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:] + points[:1], strict=True)
-    )
 
 
 def _convex(points: tuple[tuple[float, float], ...]) -> bool:
@@ -92,7 +86,7 @@ class Geometry:
                 circles.append((*shape.center, shape.radius))
             elif isinstance(shape, Polygon):
                 points = list(shape.points)
-                if _area(points) < 0:
+                if signed_area(points) < 0:
                     points.reverse()
                 for k, (x1, y1) in enumerate(points):
                     x2, y2 = points[(k + 1) % len(points)]

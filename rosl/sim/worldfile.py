@@ -24,6 +24,7 @@ from rosl.sim.model import (
     Segment,
     Shape,
     World,
+    signed_area,
 )
 from rosl.sim.yaml_reader import LINE as _LINE
 from rosl.sim.yaml_reader import LINES as _LINES
@@ -78,15 +79,8 @@ def _box(center: Point, size: tuple[float, ...], yaw: float) -> list[Point]:
     ]
 
 
-def _area(points: list[Point]) -> float:
-    """Twice the signed area (positive when the points run counter-clockwise)."""
-    return sum(
-        a[0] * b[1] - b[0] * a[1] for a, b in zip(points, points[1:] + points[:1], strict=True)
-    )
-
-
 def _ccw(points: list[Point]) -> list[Point]:
-    return points if _area(points) > 0 else points[::-1]
+    return points if signed_area(points) > 0 else points[::-1]
 
 
 def _shapes(reader: _Reader, item: Any, line: int, extra: set[str] = frozenset()) -> list[Shape]:
@@ -165,7 +159,7 @@ def _grid(reader: _Reader, entry: dict[str, Any], name: str) -> list[Shape]:
 def _check_simple(reader: _Reader, line: int, points: list[Point]) -> None:
     """Refuse a polygon whose sides cross or that has no area (pymunk could not hold it)."""
     n = len(points)
-    if abs(_area(points)) < 1e-12:
+    if abs(signed_area(points)) < 1e-12:
         raise reader.fail(line, "'points' enclose no area")
     for i in range(n):
         for j in range(i + 1, n):

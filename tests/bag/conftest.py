@@ -8,9 +8,7 @@ bytes and send times of what it hears; ``mcap_messages`` reads a bag with the mc
 
 from __future__ import annotations
 
-import fcntl
 import os
-import random
 import signal
 import subprocess
 import sys
@@ -20,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from tests.conftest import LOCK_DIR
+from tests.conftest import lock_domain
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
@@ -108,21 +106,6 @@ def mcap_messages(bag: Path, topics: set[str] | None = None) -> list[Recorded]:
     return found
 
 
-def _lock_domain() -> tuple[int, Any]:
-    LOCK_DIR.mkdir(exist_ok=True)
-    candidates = list(range(20, 233))
-    random.shuffle(candidates)
-    for domain in candidates:
-        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held for the session
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            handle.close()
-            continue
-        return domain, handle
-    pytest.fail("no free test domain id")
-
-
 def _wait_for_text(path: Path, text: str, timeout: float) -> bool:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -147,7 +130,7 @@ def scenario_bag(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """A bag recorded from real processes: /chatter (5), /numbers (3), /pose (3), 1.2 s."""
     folder = tmp_path_factory.mktemp("scenario")
     bag = folder / "scenario"
-    domain, lock = _lock_domain()
+    domain, lock = lock_domain()
     env = {**os.environ, "ROSL_DOMAIN_ID": str(domain), "PYTHONUNBUFFERED": "1"}
     env.pop("ROSL_PACKAGE_PATH", None)
     log = folder / "recorder.log"

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 import pytest
 
 from rosl.testing import assert_matches_golden, record_launch
-from tests.bag.conftest import _lock_domain, edit_field, mcap_messages, rewrite
+from tests.bag.conftest import edit_field, mcap_messages, rewrite
+from tests.conftest import lock_domain
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -64,7 +65,7 @@ def launch_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def bus_env() -> Iterator[dict[str, str]]:
-    domain, lock = _lock_domain()
+    domain, lock = lock_domain()
     try:
         yield {"ROSL_DOMAIN_ID": str(domain)}
     finally:

@@ -8,15 +8,13 @@ locked the same way as ``tests.conftest.domain_id`` (a lock file held for the mo
 from __future__ import annotations
 
 import dataclasses
-import fcntl
 import json
-import random
 import signal
 from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from tests.conftest import LOCK_DIR, Processes
+from tests.conftest import Processes, lock_domain
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -35,25 +33,10 @@ class DomainProcesses(Processes):
         return super().start(args, env=env, **kwargs)
 
 
-def _lock_domain() -> tuple[int, Any]:
-    LOCK_DIR.mkdir(exist_ok=True)
-    candidates = list(range(20, 233))
-    random.shuffle(candidates)
-    for domain in candidates:
-        handle = open(LOCK_DIR / f"{domain}.lock", "w")  # noqa: SIM115 - held for the module
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            handle.close()
-            continue
-        return domain, handle
-    pytest.fail("no free test domain id")
-
-
 @pytest.fixture(scope="module")
 def module_bus() -> Iterator[DomainProcesses]:
     """Children on a domain of their own for the whole module (ended by pid afterwards)."""
-    domain, handle = _lock_domain()
+    domain, handle = lock_domain()
     group = DomainProcesses(domain)
     try:
         yield group
@@ -134,7 +117,7 @@ def service_bag(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceBag
     from tests.bag_record import support
 
     root = tmp_path_factory.mktemp("service_bags")
-    domain, handle = _lock_domain()
+    domain, handle = lock_domain()
     group = DomainProcesses(domain)
     try:
         folder, plain = root / "with_services", root / "without_services"

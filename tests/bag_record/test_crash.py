@@ -109,9 +109,8 @@ def test_bag_info_on_a_killed_recording_says_it_is_unfinished_and_suggests_reind
     said = result.stdout + result.stderr
     assert "unfinished" in said
     assert "reindex" in said
-    if result.returncode != 0:
-        assert result.returncode == 1
-        assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert result.returncode == 0, said  # what is complete is shown; the repair is suggested
+    assert "Traceback" not in said
     # info does not repair anything by itself
     assert sorted(p.name for p in copy.iterdir()) == sorted(p.name for p in killed.raw.iterdir())
 

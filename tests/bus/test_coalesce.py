@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from rosl.bus.coalesce import RECORD, Flusher
-from rosl.bus.header import HEADER, HEADER_SIZE, MAGIC, VERSION, Flags, Kind, topic_hash
+from rosl.bus.header import HEADER, MAGIC, VERSION, Flags, Kind, topic_hash
 from rosl.bus.multicast import Addressing
 from rosl.bus.transport import MulticastTransport
 from tests.bus.test_wire import ENDPOINT, SENDER, TOPIC, Bus, payload_of
@@ -112,7 +112,6 @@ def test_a_malformed_batch_is_counted_and_the_next_one_still_arrives(counted: Co
     got = counted.bus.collector.wait_count(1, timeout=2.0)
     assert [bytes(d.payload) for d in got] == [b"fine"]
     assert counted.bus.reader.reassembler.malformed == 1
-    assert len(head) == HEADER_SIZE
 
 
 def test_closing_the_flusher_sends_what_is_pending(domain_id: int) -> None:
@@ -124,5 +123,16 @@ def test_closing_the_flusher_sends_what_is_pending(domain_id: int) -> None:
         counted.flusher.close()
         got = counted.bus.collector.wait_count(1, timeout=2.0)
         assert [bytes(d.payload) for d in got] == [b"pending"]
+    finally:
+        counted.close()
+
+
+def test_after_the_flusher_closed_a_small_message_goes_out_at_once(domain_id: int) -> None:
+    counted = Counted(domain_id, delay_s=60.0)
+    try:
+        counted.flusher.close()
+        counted.bus.writer.send(b"late")
+        got = counted.bus.collector.wait_count(1, timeout=2.0)
+        assert [bytes(d.payload) for d in got] == [b"late"]
     finally:
         counted.close()

@@ -82,13 +82,6 @@ def rosl_process() -> Callable[..., Result]:
     return run
 
 
-def run_rosl(processes: Processes, *args: str, timeout: float = 30.0) -> Result:
-    """Run the real ``rosl ARGS`` on the test's domain, piped (ROS 2's plain text); bounded."""
-    child = processes.rosl(*args, env={"NO_COLOR": "1"})
-    out, err = child.communicate(timeout=timeout)
-    return Result(child.returncode, out, err)
-
-
 def run(processes: Processes, *args: str, timeout: float = 30.0) -> Result:
     """Run the real ``rosl ARGS`` on the test's domain, piped (ROS 2's plain text); bounded."""
     child = processes.rosl(*args, env={"NO_COLOR": "1"})

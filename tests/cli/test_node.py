@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.cli.conftest import Result, assert_user_error, run_rosl
+from tests.cli.conftest import Result, assert_user_error, run
 from tests.graph.support import Watched
 
 NODES = """
@@ -88,7 +88,7 @@ def start(processes):
 
 
 def node(processes, *args: str) -> Result:
-    return run_rosl(processes, "node", *args)
+    return run(processes, "node", *args)
 
 
 def test_node_list_prints_full_names_sorted_and_hidden_ones_only_with_all(start, processes) -> None:

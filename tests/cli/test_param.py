@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.cli.conftest import assert_user_error, run_rosl
+from tests.cli.conftest import assert_user_error, run
 from tests.graph.support import Watched
 
 if TYPE_CHECKING:
@@ -111,7 +111,7 @@ def param_node(processes: Processes) -> Watched:
 @pytest.fixture
 def param(processes: Processes) -> Callable[..., Result]:
     """``rosl param ARGS`` as a real process."""
-    return lambda *args: run_rosl(processes, "param", *args)
+    return lambda *args: run(processes, "param", *args)
 
 
 def get(param: Callable[..., Result], name: str) -> str:

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
+from tests.conftest import lock_domain
 from tests.launch.support import one_error_line
 
 if TYPE_CHECKING:
@@ -37,12 +38,14 @@ def demo_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
     folder = tmp_path_factory.mktemp("viz")
     bag = folder / "run"
-    env = {**os.environ, "ROSL_DOMAIN_ID": "231", "NO_COLOR": "1"}
-    done = subprocess.run(
-        [sys.executable, "-m", "rosl", "launch", "rosl_sim", "demo.launch.py",
-         "duration:=10", f"bag:={bag}"],
-        cwd=folder, env=env, capture_output=True, text=True, timeout=120, check=False,
-    )  # fmt: skip
+    domain, lock = lock_domain()
+    env = {**os.environ, "ROSL_DOMAIN_ID": str(domain), "NO_COLOR": "1"}
+    with lock:
+        done = subprocess.run(
+            [sys.executable, "-m", "rosl", "launch", "rosl_sim", "demo.launch.py",
+             "duration:=10", f"bag:={bag}"],
+            cwd=folder, env=env, capture_output=True, text=True, timeout=120, check=False,
+        )  # fmt: skip
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     assert (bag / "metadata.yaml").is_file()
     return bag
