@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import fcntl
 import os
 import random
+import select
 import signal
 import subprocess
 import sys
@@ -197,3 +199,35 @@ def ros(domain_id: int) -> Iterator[object]:
         yield rosl
     finally:
         rosl.shutdown()
+
+
+class ChildOutput:
+    """A child's stdout/stderr read without blocking, always with a deadline (``text``)."""
+
+    def __init__(self, popen: subprocess.Popen[str]) -> None:
+        self.popen = popen
+        assert popen.stdout is not None
+        assert popen.stderr is not None
+        self._fds = {popen.stdout.fileno(): "out", popen.stderr.fileno(): "err"}
+        self._open = set(self._fds)
+        self._decoders = {
+            s: codecs.getincrementaldecoder("utf-8")("replace") for s in ("out", "err")
+        }
+        self.text = {"out": "", "err": ""}
+
+    def _read(self, timeout: float) -> None:
+        if not self._open:
+            time.sleep(min(timeout, 0.02))
+            return
+        ready, _, _ = select.select(list(self._open), [], [], max(0.0, timeout))
+        for fd in ready:
+            chunk = os.read(fd, 65536)
+            stream = self._fds[fd]
+            if chunk:
+                self.text[stream] += self._decoders[stream].decode(chunk)
+            else:
+                self._open.discard(fd)
+
+    def pump(self) -> None:
+        """Read whatever the child has printed so far (no waiting)."""
+        self._read(0.0)

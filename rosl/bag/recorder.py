@@ -32,7 +32,7 @@ from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
     from pathlib import Path
 
     from rosl.bus.wire import Delivery
@@ -469,10 +469,12 @@ class Recorder:
 
     def _other_type(self, name: str, type_name: str, delivery: Delivery) -> bool:
         """Whether ``name`` is recorded with another type (the message is counted, not written)."""
-        assert self.participant is not None
         existing = self._topics.get(name)
+        if existing is None or existing.info.type == type_name:  # every message: cheap first
+            return False
+        assert self.participant is not None
         graph = self.participant.graph
-        return existing is not None and self.other_types.left_out(
+        return self.other_types.left_out(
             name, existing.info.type, type_name, lambda: sender_name(graph, delivery, name)
         )
 
@@ -500,8 +502,6 @@ class Recorder:
 
     def _sync_graph(self) -> None:
         """Subscribe to every wanted topic (and service) as soon as the graph shows it."""
-        from rosl.node.service_events import event_topic, event_type_name
-
         assert self.participant is not None
         assert self._schemas is not None
         graph = self.participant.graph
@@ -509,17 +509,29 @@ class Recorder:
             return
         self._schemas.arrived = False  # before looking: a schema arriving now is seen next time
         self._synced = graph.generation
+        for name, type_name, service in self._unrecorded():
+            if not service:
+                self._subscribe(name, type_name)
+                continue
+            try:
+                self._subscribe(name, type_name, qos={"depth": 10})
+            except Exception:
+                continue
+
+    def _unrecorded(self) -> Iterator[tuple[str, str, bool]]:
+        """(topic, type, is a service's event topic) of what the graph offers, not yet taken."""
+        from rosl.node.service_events import event_topic, event_type_name
+
+        assert self.participant is not None
+        graph = self.participant.graph
         for _, endpoint in graph.endpoints(PUBLISHER):
             if endpoint.name not in self._topics and self.selection.wanted(endpoint.name):
-                self._subscribe(endpoint.name, endpoint.type)
+                yield endpoint.name, endpoint.type, False
         if self.services:
             for _, endpoint in graph.endpoints(SERVER):
                 name = event_topic(endpoint.name)
                 if name not in self._topics and not self.selection.excluded(name):
-                    try:
-                        self._subscribe(name, event_type_name(endpoint.type), qos={"depth": 10})
-                    except Exception:
-                        continue
+                    yield name, event_type_name(endpoint.type), True
 
     def _describe(self) -> Any:
         """The recorder as a node in the graph, subscribed to what it records."""
@@ -554,21 +566,7 @@ class Recorder:
 
     def _wanted_types(self) -> set[str]:  # the schemas thread
         """The types of the graph's wanted topics (and services) not yet recorded."""
-        from rosl.node.service_events import event_topic, event_type_name
-
-        assert self.participant is not None
-        graph = self.participant.graph
-        types = {
-            endpoint.type
-            for _, endpoint in graph.endpoints(PUBLISHER)
-            if endpoint.name not in self._topics and self.selection.wanted(endpoint.name)
-        }
-        if self.services:
-            for _, endpoint in graph.endpoints(SERVER):
-                name = event_topic(endpoint.name)
-                if name not in self._topics and not self.selection.excluded(name):
-                    types.add(event_type_name(endpoint.type))
-        return types
+        return {type_name for _, type_name, _ in self._unrecorded()}
 
     def _hold(self, delivery: Delivery) -> None:
         key = (delivery.topic, delivery.type)

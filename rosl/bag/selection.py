@@ -117,7 +117,5 @@ class OtherTypes:
 
 def sender_name(graph: GraphCache, delivery: Delivery, name: str) -> str:
     """The node that sent ``delivery`` on topic ``name``, as the graph shows it."""
-    for node, endpoint in graph.endpoints(None, name):
-        if node.process == delivery.sender and endpoint.endpoint == delivery.endpoint:
-            return f"node '{node.fqn}'"
-    return f"process {delivery.sender:#x}"
+    found = graph.sender(delivery.sender, delivery.endpoint, name=name)
+    return f"node '{found[0].fqn}'" if found else f"process {delivery.sender:#x}"

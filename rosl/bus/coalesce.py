@@ -39,8 +39,7 @@ class Batch:
         self._send = send  # (first seq, first stamp, records) -> one datagram
         self._flusher = flusher
         self._lock = threading.Lock()
-        self._records = bytearray()
-        self._first: tuple[int, int] | None = None
+        self._records = bytearray()  # the first record's seq and stamp head the datagram
 
     def fits(self, size: int) -> bool:
         """Whether a message of ``size`` bytes is small enough to be batched."""
@@ -51,10 +50,7 @@ class Batch:
         with self._lock:
             if len(self._records) + RECORD.size + len(payload) > self.limit:
                 self._flush_locked()
-            timed = True
-            if self._first is None:
-                self._first = (seq, stamp)
-                timed = self._flusher.due(self)
+            timed = bool(self._records) or self._flusher.due(self)
             self._records += RECORD.pack(seq, stamp, len(payload))
             self._records += payload
             if not timed:  # the flusher has closed: nothing would send it later
@@ -66,10 +62,10 @@ class Batch:
             self._flush_locked()
 
     def _flush_locked(self) -> None:
-        if self._first is None:
+        if not self._records:
             return
-        seq, stamp = self._first
-        records, self._records, self._first = bytes(self._records), bytearray(), None
+        seq, stamp, _ = RECORD.unpack_from(self._records)
+        records, self._records = bytes(self._records), bytearray()
         self._send(seq, stamp, records)
 
 

@@ -105,6 +105,19 @@ class GraphCache:
             if (kind is None or e.kind == kind) and (name is None or e.name == name)
         ]
 
+    def sender(
+        self, process: int, endpoint: int, kind: str | None = None, name: str | None = None
+    ) -> tuple[NodeRecord, EndpointRecord] | None:
+        """The endpoint a message came from (its process and endpoint number), with its node."""
+        with self._changed:
+            record = self._processes.get(process)
+        for node in record.nodes if record is not None else ():
+            for e in node.endpoints:
+                same_kind = kind is None or e.kind == kind
+                if e.endpoint == endpoint and same_kind and (name is None or e.name == name):
+                    return node, e
+        return None
+
     def topics(self) -> dict[str, list[str]]:
         """Topic name → sorted types, over publishers and subscriptions."""
         return self._names((PUBLISHER, SUBSCRIPTION))

@@ -169,12 +169,8 @@ class Subscription:
         if delivery.sender in self._warned:
             return
         self._warned.add(delivery.sender)
-        senders = [
-            (node.fqn, e.type)
-            for node, e in self.node.participant.graph.endpoints(PUBLISHER, self.topic)
-            if node.process == delivery.sender and e.type != self.type_name
-        ]
-        who = f" from {senders[0][0]} ({senders[0][1]})" if senders else ""
+        found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)
+        who = f" from {found[0].fqn} ({found[1].type})" if found else ""
         self.node.get_logger().warn(
             f"subscription on {self.topic} expects {self.type_name} but got a message of another "
             f"type{who}; dropped without decoding (publisher and subscriber types must match)"
@@ -200,18 +196,18 @@ class Subscription:
         """
         generation = self._graph.generation
         stats = self._streams.get((delivery.sender, delivery.endpoint))
-        for node, endpoint in self._graph.endpoints(PUBLISHER, self.topic):
-            if node.process != delivery.sender or endpoint.endpoint != delivery.endpoint:
-                continue
-            agrees = not endpoint.digest or not self.digest or endpoint.digest == self.digest
-            if not agrees:
-                self.node.get_logger().warn(
-                    f"subscription on {self.topic} expects {self.type_name} as this process's "
-                    f".msg files define it, but {node.fqn} publishes another definition of it "
-                    "(one of the two .msg files changed); dropped without decoding"
-                )
-            return _Peer(agrees, generation, stats)
-        return _Peer(None, generation, stats)
+        found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)
+        if found is None:
+            return _Peer(None, generation, stats)
+        node, endpoint = found
+        agrees = not endpoint.digest or not self.digest or endpoint.digest == self.digest
+        if not agrees:
+            self.node.get_logger().warn(
+                f"subscription on {self.topic} expects {self.type_name} as this process's "
+                f".msg files define it, but {node.fqn} publishes another definition of it "
+                "(one of the two .msg files changed); dropped without decoding"
+            )
+        return _Peer(agrees, generation, stats)
 
     @property
     def lost(self) -> int:

@@ -10,12 +10,10 @@ same way), and compared with what the test serialises itself.
 
 from __future__ import annotations
 
-import codecs
 import dataclasses
 import json
 import os
 import re
-import select
 import signal
 import subprocess
 import sys
@@ -24,6 +22,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
+
+from tests.conftest import ChildOutput
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -36,40 +36,12 @@ STOP_TIMEOUT = 15.0
 # --- children ----------------------------------------------------------------------------------
 
 
-class Child:
+class Child(ChildOutput):
     """A child whose stdout/stderr are read with ``select`` and bounded waits."""
-
-    def __init__(self, popen: subprocess.Popen[str]) -> None:
-        self.popen = popen
-        assert popen.stdout is not None
-        assert popen.stderr is not None
-        self._fds = {popen.stdout.fileno(): "out", popen.stderr.fileno(): "err"}
-        self._open = set(self._fds)
-        self._decoders = {
-            s: codecs.getincrementaldecoder("utf-8")("replace") for s in ("out", "err")
-        }
-        self.text = {"out": "", "err": ""}
 
     @property
     def pid(self) -> int:
         return self.popen.pid
-
-    def _read(self, timeout: float) -> None:
-        if not self._open:
-            time.sleep(min(timeout, 0.02))
-            return
-        ready, _, _ = select.select(list(self._open), [], [], max(0.0, timeout))
-        for fd in ready:
-            chunk = os.read(fd, 65536)
-            stream = self._fds[fd]
-            if chunk:
-                self.text[stream] += self._decoders[stream].decode(chunk)
-            else:
-                self._open.discard(fd)
-
-    def pump(self) -> None:
-        """Read whatever is there now."""
-        self._read(0.0)
 
     def lines(self, stream: str = "out") -> list[str]:
         self.pump()

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import codecs
 import contextlib
-import os
 import re
-import select
 import subprocess
 import textwrap
 import time
 from typing import TYPE_CHECKING, Any
+
+from tests.conftest import ChildOutput
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -20,39 +19,16 @@ if TYPE_CHECKING:
 STREAMS = ("out", "err")
 
 
-class Child:
+class Child(ChildOutput):
     """A child process whose stdout/stderr are read without blocking, always with a deadline."""
 
     def __init__(self, popen: subprocess.Popen[str], processes: Processes) -> None:
-        self.popen = popen
+        super().__init__(popen)
         self._processes = processes
-        assert popen.stdout is not None
-        assert popen.stderr is not None
-        self._fds = {popen.stdout.fileno(): "out", popen.stderr.fileno(): "err"}
-        self._open = set(self._fds)
-        self._decoders = {s: codecs.getincrementaldecoder("utf-8")("replace") for s in STREAMS}
-        self.text = {s: "" for s in STREAMS}
         self._pos = {s: 0 for s in STREAMS}
         self.stopped = False
 
     # --- reading ---------------------------------------------------------------------------
-
-    def _read(self, timeout: float) -> None:
-        if not self._open:
-            time.sleep(min(timeout, 0.02))
-            return
-        ready, _, _ = select.select(list(self._open), [], [], max(0.0, timeout))
-        for fd in ready:
-            chunk = os.read(fd, 65536)
-            stream = self._fds[fd]
-            if chunk:
-                self.text[stream] += self._decoders[stream].decode(chunk)
-            else:
-                self._open.discard(fd)
-
-    def pump(self) -> None:
-        """Read whatever the child has printed so far (no waiting)."""
-        self._read(0.0)
 
     def wait_for(self, pattern: str, *, stream: str = "out", timeout: float = 10.0) -> Any:
         """The next match of ``pattern`` (multiline regex) after the last one, or None."""
