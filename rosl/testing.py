@@ -103,7 +103,7 @@ def record_launch(
     """
     target = [str(part) for part in launch] if isinstance(launch, tuple) else [str(launch)]
     args = [f"{key}:={value}" for key, value in (arguments or {}).items()]
-    rosl = [sys.executable, "-m", "rosl"]
+    rosl = [sys.executable, "-P", "-m", "rosl"]  # -P: a rosl/ folder here cannot shadow rosl
     full_env = {**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})}
     log_path = output.parent / f"{output.name}.log"
     output.parent.mkdir(parents=True, exist_ok=True)

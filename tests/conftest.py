@@ -179,7 +179,9 @@ def processes(domain_id: int) -> Iterator[Processes]:
         group.close()
 
 
-def wait_until(predicate: Callable[[], bool], timeout: float = 5.0, interval: float = 0.02) -> bool:
+def wait_until(
+    predicate: Callable[[], bool], timeout: float = 15.0, interval: float = 0.02
+) -> bool:
     """Poll ``predicate`` until true or the (bounded) timeout."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import yaml
 
@@ -190,7 +190,7 @@ def _optional_list(path: Path, information: dict[str, Any], key: str) -> list[An
     if value is None:
         return []
     _expect(path, key, value, list)
-    return value  # type: ignore[no-any-return]
+    return cast("list[Any]", value)  # _expect refused anything else
 
 
 _SHAPES = {list: "a list", dict: "a mapping", str: "a text", int: "a whole number"}

@@ -16,4 +16,6 @@ How topics map to the network (documented here because users and tools rely on i
   checked before any payload is touched.
 * By default everything leaves through 127.0.0.1 with TTL 0: nothing leaves the host.
   ``ROSL_INTERFACE=<name or address>`` sends and joins on that interface with TTL 1 instead.
+* ``probe.py`` is ROS 2's multicast check (``rosl multicast send|receive``): one datagram to
+  225.0.0.1:49150, in the same scope (loopback unless ``ROSL_INTERFACE`` names one).
 """

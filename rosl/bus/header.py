@@ -49,6 +49,7 @@ class Kind(enum.IntEnum):
     RESPONSE = 3  # a service response (addressed to the client)
     DISCOVERY = 4  # node announcements, graph queries, goodbyes
     REPLAY = 5  # transient-local history for one late subscriber (addressed)
+    FAILURE = 6  # a server's answer that its callback failed (addressed; JSON, see node/service)
 
 
 class Flags(enum.IntFlag):
@@ -67,12 +68,14 @@ class Header(NamedTuple):
     version: int
     kind: int
     flags: int
-    count: int
+    # ``count`` and ``index`` are the wire's fragment fields; as NamedTuple fields they hide
+    # tuple.count()/tuple.index(), which nothing calls on a Header.
+    count: int  # type: ignore[assignment]
     sender: int
     seq: int
     topic: int
     type: int
-    index: int
+    index: int  # type: ignore[assignment]
     endpoint: int
     total: int
     stamp: int

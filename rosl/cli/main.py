@@ -18,12 +18,18 @@ import click
 from rosl.errors import RoslError
 
 # name -> (module, one-line help); the module defines a click command named ``command``
+# (``module:name`` picks another attribute)
 COMMANDS: dict[str, tuple[str, str]] = {
+    "action": ("rosl.cli.planned:action", "Actions: not in rosl yet"),
     "bag": ("rosl.cli.bag", "Various rosbag related sub-commands"),
+    "component": ("rosl.cli.planned:component", "Components: not in rosl (C++ only)"),
+    "daemon": ("rosl.cli.daemon", "rosl has no daemon: start/stop/status say so"),
     "doctor": ("rosl.cli.doctor", "Check the setup: multicast, domain, packages, graph"),
     "graph": ("rosl.cli.graph", "The node/topic graph as DOT, Mermaid or text (rqt_graph)"),
     "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),
     "launch": ("rosl.cli.launch", "Run a launch file"),
+    "lifecycle": ("rosl.cli.planned:lifecycle", "Lifecycle nodes: not in rosl yet"),
+    "multicast": ("rosl.cli.multicast", "Various multicast related sub-commands"),
     "node": ("rosl.cli.node", "Various node related sub-commands"),
     "param": ("rosl.cli.param", "Various param related sub-commands"),
     "pkg": ("rosl.cli.pkg", "Various package related sub-commands"),
@@ -33,6 +39,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "tf": ("rosl.cli.tf", "TF frames: the tree (view_frames) and transforms (tf2_echo)"),
     "topic": ("rosl.cli.topic", "Various topic related sub-commands"),
     "viz": ("rosl.cli.viz", "Draw the world, paths, scans and frames from a bag or the bus"),
+    "wtf": ("rosl.cli.doctor", "Use `wtf` as alias to `doctor`"),
 }
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
@@ -48,8 +55,9 @@ class LazyGroup(click.Group):
         """Import and return one command."""
         if cmd_name not in COMMANDS:
             return None
-        module = importlib.import_module(COMMANDS[cmd_name][0])
-        command: click.Command = module.command
+        module_name, _, attribute = COMMANDS[cmd_name][0].partition(":")
+        module = importlib.import_module(module_name)
+        command: click.Command = getattr(module, attribute or "command")
         return command
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
@@ -78,7 +86,10 @@ def cli() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line and return (or exit with) its status."""
+    from rosl.pkg import interrupts
+
     try:
+        interrupts.release()  # a Ctrl-C held since start-up (a launch's helper) lands here: 130
         result: Any = cli.main(args=argv, prog_name="rosl", standalone_mode=False)
     except click.exceptions.Exit as done:
         return _exit(done.exit_code)

@@ -28,6 +28,11 @@ def command() -> None:
     """Various param related sub-commands."""
 
 
+hidden_nodes_option = click.option(
+    "--include-hidden-nodes", "include_hidden", is_flag=True, help="Consider hidden nodes as well"
+)
+
+
 @command.command("list")
 @click.argument("node_name", required=False)
 @click.option(
@@ -44,9 +49,7 @@ def command() -> None:
     help="Only list parameters with the provided prefixes",
 )
 @click.option("--param-type", is_flag=True, help="Print parameter types with parameter names")
-@click.option(
-    "--include-hidden-nodes", "include_hidden", is_flag=True, help="Consider hidden nodes as well"
-)
+@hidden_nodes_option
 @domain_option
 def list_(
     node_name: str | None,
@@ -58,6 +61,8 @@ def list_(
 ) -> None:
     """Output a list of available parameters."""
     with Session(domain_id) as session:
+        if node_name:
+            params.require_node(session, node_name, include_hidden=include_hidden)
         render.lines(
             params.param_list(
                 session,
@@ -74,10 +79,18 @@ def list_(
 @click.argument("node_name")
 @click.argument("parameter_name")
 @click.option("--hide-type", is_flag=True, help="Hide the type information")
+@hidden_nodes_option
 @domain_option
-def get(node_name: str, parameter_name: str, hide_type: bool, domain_id: int | None) -> None:
+def get(
+    node_name: str,
+    parameter_name: str,
+    hide_type: bool,
+    include_hidden: bool,
+    domain_id: int | None,
+) -> None:
     """Get parameter."""
     with Session(domain_id) as session:
+        params.require_node(session, node_name, include_hidden=include_hidden)
         render.text(params.get(session, node_name, parameter_name, hide_type=hide_type) + "\n")
 
 
@@ -85,8 +98,15 @@ def get(node_name: str, parameter_name: str, hide_type: bool, domain_id: int | N
 @click.argument("node_name")
 @click.argument("pairs", nargs=-1, required=True, metavar="NAME VALUE [NAME VALUE ...]")
 @click.option("--atomic", is_flag=True, help="Set all parameters or none")
+@hidden_nodes_option
 @domain_option
-def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | None) -> int:
+def set_(
+    node_name: str,
+    pairs: tuple[str, ...],
+    atomic: bool,
+    include_hidden: bool,
+    domain_id: int | None,
+) -> int:
     """Set parameter(s); values are YAML (1 int, 1.0 double, -1.0, true bool, '[1, 2]')."""
     # unknown options are kept as arguments so that negative values (-1.0) stay values
     for name in pairs[::2]:
@@ -98,6 +118,7 @@ def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | 
             f"Got {len(pairs)} argument(s)."
         )
     with Session(domain_id) as session:
+        params.require_node(session, node_name, include_hidden=include_hidden)
         outcomes = params.set_values(
             session, node_name, list(zip(pairs[::2], pairs[1::2], strict=True)), atomic=atomic
         )
@@ -107,41 +128,61 @@ def set_(node_name: str, pairs: tuple[str, ...], atomic: bool, domain_id: int | 
 @command.command("delete")
 @click.argument("node_name")
 @click.argument("parameter_name")
+@hidden_nodes_option
 @domain_option
-def delete(node_name: str, parameter_name: str, domain_id: int | None) -> None:
+def delete(
+    node_name: str, parameter_name: str, include_hidden: bool, domain_id: int | None
+) -> None:
     """Delete parameter."""
     with Session(domain_id) as session:
+        params.require_node(session, node_name, include_hidden=include_hidden)
         render.text(params.delete(session, node_name, parameter_name) + "\n")
 
 
 @command.command("describe")
 @click.argument("node_name")
 @click.argument("parameter_names", nargs=-1, required=True)
+@hidden_nodes_option
 @domain_option
-def describe(node_name: str, parameter_names: tuple[str, ...], domain_id: int | None) -> None:
+def describe(
+    node_name: str, parameter_names: tuple[str, ...], include_hidden: bool, domain_id: int | None
+) -> None:
     """Show descriptive information about declared parameters."""
     with Session(domain_id) as session:
+        params.require_node(session, node_name, include_hidden=include_hidden)
         render.lines(params.describe(session, node_name, list(parameter_names)))
 
 
 @command.command("dump")
 @click.argument("node_name")
+@hidden_nodes_option
 @click.option(
     "--output-dir",
-    type=click.Path(file_okay=False, path_type=Path),
     default=None,
-    help="Write <node>.yaml into this folder instead of printing",
+    help="DEPRECATED: The absolute path where to save the generated file",
 )
-@click.option("--print", "print_", is_flag=True, help="Print (the default; kept for compatibility)")
+@click.option("--print", "print_", is_flag=True, help="DEPRECATED: Does nothing.")
 @domain_option
-def dump(node_name: str, output_dir: Path | None, print_: bool, domain_id: int | None) -> None:
+def dump(
+    node_name: str,
+    include_hidden: bool,
+    output_dir: str | None,
+    print_: bool,
+    domain_id: int | None,
+) -> None:
     """Show all of the parameters of a node in a YAML file format."""
-    del print_
     with Session(domain_id) as session:
-        if output_dir is None:
-            render.text(params.dump(session, node_name))
-        else:
-            render.text(f"Saving to:  {params.dump_to_dir(session, node_name, output_dir)}\n")
+        params.require_node(session, node_name, include_hidden=include_hidden)
+        if print_:
+            render.warn(
+                "WARNING: '--print' is deprecated; this utility prints to stdout by default"
+            )
+        if output_dir is None or output_dir == ".":  # ros2's print(): a blank line follows
+            render.text(params.dump(session, node_name) + "\n")
+            return
+        path = params.dump_to_dir(session, node_name, output_dir)
+    render.warn("WARNING: '--output-dir' is deprecated; use redirection to save to a file")
+    render.text(f"Saving to:  {path}\n")
 
 
 @command.command("load")
@@ -152,9 +193,17 @@ def dump(node_name: str, output_dir: Path | None, print_: bool, domain_id: int |
     is_flag=True,
     help="Do not load parameters in the '/**' namespace into the node",
 )
+@hidden_nodes_option
 @domain_option
-def load(node_name: str, parameter_file: Path, no_use_wildcard: bool, domain_id: int | None) -> int:
+def load(
+    node_name: str,
+    parameter_file: Path,
+    no_use_wildcard: bool,
+    include_hidden: bool,
+    domain_id: int | None,
+) -> int:
     """Load parameter file for a node."""
     with Session(domain_id) as session:
+        params.require_node(session, node_name, include_hidden=include_hidden)
         outcomes = params.load(session, node_name, parameter_file, use_wildcard=not no_use_wildcard)
     return _report(outcomes)

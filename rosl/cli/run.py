@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shlex
+import signal
 import sys
 
 import click
@@ -33,4 +34,23 @@ def command(
     cmd = [*(shlex.split(prefix) if prefix else []), *command_line(executable, list(argv))]
     sys.stdout.flush()
     sys.stderr.flush()
-    os.execvp(cmd[0], cmd)
+    _exec(cmd)
+
+
+def _exec(cmd: list[str]) -> None:
+    """Become ``cmd``: SIGINT at its default (even in a background job), held for rosl's entry."""
+    from rosl.pkg import interrupts
+
+    hold = interrupts.takes_held_sigint(cmd)
+    os.environ.pop(interrupts.HELD, None)
+    if hold:
+        os.environ[interrupts.HELD] = "1"
+    previous = signal.getsignal(signal.SIGINT)
+    interrupts.prepare_child(hold)
+    try:
+        os.execvp(cmd[0], cmd)
+    except OSError:
+        os.environ.pop(interrupts.HELD, None)
+        signal.signal(signal.SIGINT, previous if previous is not None else signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+        raise

@@ -7,7 +7,7 @@ import click
 from rosl.cli import render
 from rosl.cli.options import domain_option
 from rosl.introspection import services
-from rosl.introspection.session import Session
+from rosl.introspection.session import Session, visible
 
 hidden_option = click.option(
     "--include-hidden-services",
@@ -18,8 +18,16 @@ hidden_option = click.option(
 
 
 @click.group("service")
-def command() -> None:
+@hidden_option
+def command(include_hidden: bool) -> None:
     """Various service related sub-commands."""
+    del include_hidden  # read by the verbs: `rosl service --include-hidden-services list`
+
+
+def _hidden(include_hidden: bool) -> bool:
+    """The verb's ``--include-hidden-services``, or the group's (ros2 puts it there)."""
+    parent = click.get_current_context().parent
+    return include_hidden or bool(parent is not None and parent.params.get("include_hidden"))
 
 
 @command.command("list")
@@ -34,18 +42,22 @@ def list_(show_types: bool, count: bool, include_hidden: bool, domain_id: int | 
     with Session(domain_id) as session:
         render.lines(
             services.list_services(
-                session, show_types=show_types, count=count, include_hidden=include_hidden
+                session, show_types=show_types, count=count, include_hidden=_hidden(include_hidden)
             )
         )
 
 
 @command.command("type")
 @click.argument("service_name")
+@hidden_option
 @domain_option
-def type_(service_name: str, domain_id: int | None) -> None:
-    """Output a service's type."""
+def type_(service_name: str, include_hidden: bool, domain_id: int | None) -> None:
+    """Output a service's type (an unknown or hidden one prints nothing and exits 1, as ros2)."""
     with Session(domain_id) as session:
-        render.lines(session.service_types(service_name))
+        types = session.graph().services().get(service_name)
+    if not types or not visible(service_name, _hidden(include_hidden)):
+        raise click.exceptions.Exit(1)
+    render.lines(types)
 
 
 @command.command("find")
@@ -58,7 +70,9 @@ def type_(service_name: str, domain_id: int | None) -> None:
 def find(service_type: str, count: bool, include_hidden: bool, domain_id: int | None) -> None:
     """Output a list of available services of a given type."""
     with Session(domain_id) as session:
-        found = services.find_services(session, service_type, include_hidden=include_hidden)
+        found = services.find_services(
+            session, service_type, include_hidden=_hidden(include_hidden)
+        )
         render.lines([str(len(found))] if count else found)
 
 
@@ -98,7 +112,8 @@ def call(
     from rosl.idl.yaml_io import parse_yaml_mapping
 
     if service_type is not None and service_type.lstrip().startswith("{"):
-        service_type, values = None, service_type  # `call /srv "{a: 1}"` without a type
+        values = service_type  # `call /srv "{a: 1}"` without a type
+        service_type = None
     data = parse_yaml_mapping(values, "request values")
     with Session(domain_id) as session:
         for block in services.call(

@@ -2,24 +2,91 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import click
 
 from rosl.cli import render
 from rosl.cli.options import domain_option
 from rosl.introspection import echo as echo_
-from rosl.introspection import monitor, topics
+from rosl.introspection import monitor, qos_words, topics
 from rosl.introspection import publish as publish_
-from rosl.introspection.session import Session
+from rosl.introspection.session import Session, visible
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
-@click.group("topic")
-def command() -> None:
-    """Various topic related sub-commands."""
-
+    from rosl.node.qos import QoSProfile
 
 hidden_option = click.option(
     "--include-hidden-topics", "include_hidden", is_flag=True, help="Consider hidden topics as well"
 )
+
+
+@click.group("topic")
+@hidden_option
+def command(include_hidden: bool) -> None:
+    """Various topic related sub-commands."""
+    del include_hidden  # read by the verbs: `rosl topic --include-hidden-topics list`
+
+
+def _hidden(include_hidden: bool) -> bool:
+    """The verb's ``--include-hidden-topics``, or the group's (ros2 puts it there)."""
+    parent = click.get_current_context().parent
+    return include_hidden or bool(parent is not None and parent.params.get("include_hidden"))
+
+
+def qos_options(what: str, default_profile: str) -> Callable[[Any], Any]:
+    """ros2's ``--qos-profile/--qos-depth/--qos-history/--qos-reliability/--qos-durability``."""
+
+    def choice(name: str, words: tuple[str, ...], text: str) -> Any:
+        return click.option(name, type=click.Choice(words), default=None, help=text)
+
+    def add(command: Any) -> Any:
+        for decorator in reversed(
+            [
+                choice(
+                    "--qos-profile",
+                    qos_words.PROFILES,
+                    f"Quality of service preset profile to {what} with "
+                    f"(default: {default_profile})",
+                ),
+                click.option(
+                    "--qos-depth",
+                    type=int,
+                    default=None,
+                    metavar="N",
+                    help=f"Queue size setting to {what} with (overrides --qos-profile)",
+                ),
+                choice("--qos-history", qos_words.HISTORIES, "History of samples (overrides)"),
+                choice("--qos-reliability", qos_words.RELIABILITIES, "Reliability (overrides)"),
+                choice("--qos-durability", qos_words.DURABILITIES, "Durability (overrides)"),
+            ]
+        ):
+            command = decorator(command)
+        return command
+
+    return add
+
+
+def _qos(
+    default_profile: str,
+    profile: str | None,
+    depth: int | None,
+    history: str | None,
+    reliability: str | None,
+    durability: str | None,
+) -> QoSProfile | None:
+    """The profile the ``--qos-*`` words ask for; None when none was given."""
+    if not qos_words.given(profile, depth, history, reliability, durability):
+        return None
+    return qos_words.profile_from_words(
+        profile or default_profile,
+        reliability=reliability,
+        durability=durability,
+        depth=depth,
+        history=history,
+    )
 
 
 @command.command("list")
@@ -41,7 +108,7 @@ def list_(
                 show_types=show_types,
                 count=count,
                 verbose=verbose,
-                include_hidden=include_hidden,
+                include_hidden=_hidden(include_hidden),
             )
         )
 
@@ -54,21 +121,23 @@ def list_(
     is_flag=True,
     help="Prints detailed information like the node name, GID and QoS",
 )
+@click.option("--stats", is_flag=True, help="With -v: each endpoint's sent/received/lost counts")
 @domain_option
-def info(topic_name: str, verbose: bool, domain_id: int | None) -> None:
+def info(topic_name: str, verbose: bool, stats: bool, domain_id: int | None) -> None:
     """Print information about a topic."""
     with Session(domain_id) as session:
-        render.lines(topics.topic_info(session, topic_name, verbose=verbose))
+        render.lines(topics.topic_info(session, topic_name, verbose=verbose, stats=stats))
 
 
 @command.command("type")
 @click.argument("topic_name")
+@hidden_option
 @domain_option
-def type_(topic_name: str, domain_id: int | None) -> None:
-    """Print a topic's type (an unknown topic prints nothing and exits 1, as in ros2)."""
+def type_(topic_name: str, include_hidden: bool, domain_id: int | None) -> None:
+    """Print a topic's type (an unknown or hidden one prints nothing and exits 1, as in ros2)."""
     with Session(domain_id) as session:
         types = session.graph().topics().get(topic_name)
-    if not types:
+    if not types or not visible(topic_name, _hidden(include_hidden)):
         raise click.exceptions.Exit(1)
     render.lines(types)
 
@@ -83,7 +152,7 @@ def type_(topic_name: str, domain_id: int | None) -> None:
 def find(topic_type: str, count: bool, include_hidden: bool, domain_id: int | None) -> None:
     """Output a list of available topics of a given type."""
     with Session(domain_id) as session:
-        found = topics.find_topics(session, topic_type, include_hidden=include_hidden)
+        found = topics.find_topics(session, topic_type, include_hidden=_hidden(include_hidden))
         render.lines([str(len(found))] if count else found)
 
 
@@ -119,6 +188,10 @@ def find(topic_type: str, count: bool, include_hidden: bool, domain_id: int | No
     is_flag=True,
     help="Show the message info (timestamps, sequence)",
 )
+@qos_options("subscribe", "sensor_data")
+@click.option("--no-lost-messages", is_flag=True, help="Don't report when a message is lost")
+@click.option("--lost-messages", is_flag=True, hidden=True, help="DEPRECATED: Does nothing")
+@click.option("--raw", is_flag=True, help="Echo the raw binary representation")
 @domain_option
 def echo(
     topic_name: str,
@@ -134,9 +207,22 @@ def echo(
     filter_expr: str | None,
     timeout: float | None,
     include_message_info: bool,
+    qos_profile: str | None,
+    qos_depth: int | None,
+    qos_history: str | None,
+    qos_reliability: str | None,
+    qos_durability: str | None,
+    no_lost_messages: bool,
+    lost_messages: bool,
+    raw: bool,
     domain_id: int | None,
 ) -> None:
     """Output messages from a topic."""
+    if lost_messages:
+        render.warn(
+            "WARNING: '--lost-messages' is deprecated; lost messages are reported by default"
+        )
+    qos = _qos("sensor_data", qos_profile, qos_depth, qos_history, qos_reliability, qos_durability)
     options = echo_.EchoOptions(
         once=once,
         field=field,
@@ -148,6 +234,9 @@ def echo(
         filter_expr=filter_expr,
         timeout=timeout,
         include_info=include_message_info,
+        qos=qos,
+        lost_messages=not no_lost_messages,
+        raw=raw,
     )
     with Session(domain_id) as session:
         for block in echo_.echo(session, topic_name, message_type, options):
@@ -175,6 +264,8 @@ def hz(
     """Print the average receiving rate (timed at the socket, no decoding)."""
     del wall_time
     with Session(domain_id) as session:
+        for hint in monitor.close_names(session, list(topic_names)):
+            render.warn(hint)
         for block in monitor.hz(session, list(topic_names), window, filter_expr):
             render.text(block + "\n")
 
@@ -186,6 +277,8 @@ def hz(
 def bw(topic_name: str, window: int, domain_id: int | None) -> None:
     """Display bandwidth used by a topic."""
     with Session(domain_id) as session:
+        for hint in monitor.close_names(session, [topic_name]):
+            render.warn(hint)
         for block in monitor.bw(session, topic_name, window):
             render.text(block + "\n")
 
@@ -235,9 +328,7 @@ def delay(topic_name: str, window: int, domain_id: int | None) -> None:
     default=0.1,
     help="Keep publishing node alive for N seconds after the last msg",
 )
-@click.option(
-    "--qos-durability", type=click.Choice(["volatile", "transient_local"]), default="volatile"
-)
+@qos_options("publish", "system_default")
 @domain_option
 def pub(
     topic_name: str,
@@ -250,7 +341,11 @@ def pub(
     wait_matching: int | None,
     max_wait: float,
     keep_alive: float,
-    qos_durability: str,
+    qos_profile: str | None,
+    qos_depth: int | None,
+    qos_history: str | None,
+    qos_reliability: str | None,
+    qos_durability: str | None,
     domain_id: int | None,
 ) -> None:
     """Publish a message to a topic."""
@@ -265,7 +360,9 @@ def pub(
         wait_matching=wait_matching,
         max_wait=max_wait,
         keep_alive=keep_alive,
-        transient_local=qos_durability == "transient_local",
+        qos=_qos(
+            "system_default", qos_profile, qos_depth, qos_history, qos_reliability, qos_durability
+        ),
     )
     with Session(domain_id) as session:
         for stream, line in publish_.publish(session, topic_name, message_type, data, options):

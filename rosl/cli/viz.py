@@ -23,7 +23,8 @@ from rosl.cli.options import domain_option
     "--fixed-frame",
     "-f",
     default=None,
-    help="The frame everything is drawn in (RViz's Fixed Frame)  [default: odom]",
+    help="The frame everything is drawn in (RViz's Fixed Frame)  [default: odom, or the "
+    "odometry's frame when there is no odom]",
 )
 @click.option(
     "-d",
@@ -51,8 +52,8 @@ def command(
     """Draw a bag (`rosl viz run1 -o path.png`) or the live system (`rosl viz -o now.png`)."""
     from rosl.introspection import viz
 
-    if fixed_frame is None:
-        fixed_frame = viz.rviz_fixed_frame(display_config) if display_config else "odom"
+    if fixed_frame is None and display_config is not None:
+        fixed_frame = viz.rviz_fixed_frame(display_config)
 
     if bag is not None:
         if not bag.exists():
@@ -67,4 +68,5 @@ def command(
         with Session(domain_id) as session:
             builder = viz.live(session, fixed_frame, duration)
         title = "live"
-    render.lines([f"wrote {viz.draw(builder, target, title)}"])
+    written = viz.draw(builder, target, title)
+    render.lines([*([builder.note] if builder.note else []), f"wrote {written}"])

@@ -56,7 +56,8 @@ class AliasFinder(importlib.abc.MetaPathFinder):
             if real is not None and real.origin not in (None, "namespace"):
                 return None
         parent = sys.modules.get(top)
-        if rest and parent is not None and not isinstance(parent.__spec__.loader, _AliasLoader):
+        loader = getattr(parent.__spec__, "loader", None) if parent is not None else None
+        if rest and parent is not None and not isinstance(loader, _AliasLoader):
             return None  # a real top-level package: its own submodules
         name = ALIASES[top] + (f".{rest}" if rest else "")
         if importlib.util.find_spec(name) is None:

@@ -221,7 +221,8 @@ class Discovery:
             self._check_selftest(now)
             wait = max(0.0, min(self._announce_due - time.monotonic(), 0.5))
             try:
-                ready, _, _ = select.select([self._socket, self._wake_read], [], [], wait)
+                watched: list[socket.socket | int] = [self._socket, self._wake_read]
+                ready, _, _ = select.select(watched, [], [], wait)
             except (OSError, ValueError):
                 return  # closed during shutdown
             if self._wake_read in ready:

@@ -32,6 +32,7 @@ class Message:
             return NotImplemented
         return all(_equal(getattr(self, n), getattr(other, n)) for n in self._fields)
 
+    # unhashable (mutable, as rclpy's messages); typeshed types object.__hash__ as a method
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:

@@ -9,6 +9,7 @@ kept at the top level, dropped in nested definitions (``all_comments`` keeps the
 from __future__ import annotations
 
 from rosl.idl import registry
+from rosl.idl.base import ServiceType
 from rosl.idl.errors import InterfaceError
 from rosl.idl.names import TypeName, parse_type_name
 from rosl.idl.parser import ServiceSpec, split_comment
@@ -69,5 +70,5 @@ def prototype(type_name: str) -> str:
     from rosl.idl.yaml_io import message_to_yaml
 
     cls = registry.get_interface(str(_interface_name(type_name)))
-    message_cls = getattr(cls, "Request", cls)
+    message_cls = cls.Request if issubclass(cls, ServiceType) else cls
     return message_to_yaml(message_cls())

@@ -64,6 +64,12 @@ def struct_idl(spec: MessageSpec) -> str:
     return "\n".join(lines)
 
 
+def _message_spec(name: str) -> MessageSpec:
+    spec = registry.load_spec(name)
+    assert isinstance(spec, MessageSpec)  # a recorded type or a field's type: a message
+    return registry.resolve(spec)
+
+
 def full_idl(type_name: str) -> str:
     """A type and every type it uses, as sectioned IDL (rosbag2's ``ros2idl`` layout)."""
     order: list[str] = []
@@ -72,7 +78,7 @@ def full_idl(type_name: str) -> str:
         if name in order:
             return
         order.append(name)
-        spec = registry.resolve(registry.load_spec(name))  # type: ignore[arg-type]
+        spec = _message_spec(name)
         for field in spec.fields:
             if not field.type.is_primitive:
                 visit(field.type.base)
@@ -81,6 +87,6 @@ def full_idl(type_name: str) -> str:
     visit(type_name)
     sections = []
     for name in order:
-        spec = registry.resolve(registry.load_spec(name))  # type: ignore[arg-type]
+        spec = _message_spec(name)
         sections.append(f"{DELIMITER}\nIDL: {name}\n{struct_idl(spec)}")
     return "".join(sections)

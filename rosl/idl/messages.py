@@ -6,6 +6,10 @@ message costs one Python call. Numeric arrays are numpy arrays of the field's dt
 properties that accept lists, tuples, ``bytes`` (for 8-bit types) and numpy arrays, and check
 fixed lengths and bounds on assignment. Scalars are plain attributes: a wrong value is found
 when the message is serialized (``store``), where ``check_fields`` names the field.
+
+``byte`` is as rclpy has it: a ``bytes`` object of length 1 (``bytes([0])``), and a byte array is
+a list of them; both are properties that also take 0..255 (and rosbags' signed int8, which is
+how the CDR serializer reads and writes them: :func:`wire_view`). ``char`` is an int.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from __future__ import annotations
 import keyword
 import operator
 from collections.abc import Callable, Mapping
+from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -36,7 +41,6 @@ __all__ = [
 
 DTYPES: dict[str, Any] = {
     "bool": np.bool_,
-    "byte": np.int8,
     "char": np.uint8,
     "int8": np.int8,
     "uint8": np.uint8,
@@ -53,10 +57,62 @@ _ZERO: dict[str, Any] = {"bool": False, "string": "", **dict.fromkeys(FLOATS, 0.
 DUMMY_FIELD = "structure_needs_at_least_one_member"
 
 
+_BYTES = tuple(bytes((i,)) for i in range(256))  # each byte value once, shared
+
+
 def _scalar_default(ftype: FieldType, default: Any) -> Any:
+    if ftype.base == "byte":
+        return _BYTES[(default or 0) & 0xFF]
     if default is not None:
         return default
     return _ZERO.get(ftype.base, 0)
+
+
+def to_byte(value: Any, where: str) -> bytes:
+    """Return a ``byte`` value as rclpy holds it (``bytes`` of length 1).
+
+    Takes bytes of length 1, a whole number from -128 (rosbags' int8) to 255, or a string of
+    one character up to U+00FF (what ``ros2 topic echo`` prints for a byte).
+
+    Raises:
+        FieldError: anything else, naming ``where``.
+    """
+    if isinstance(value, (bytes, bytearray)) and len(value) == 1:
+        return _BYTES[value[0]]
+    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        if -128 <= value <= 255:
+            return _BYTES[int(value) & 0xFF]
+    elif isinstance(value, str) and len(value) == 1 and ord(value) <= 255:
+        return _BYTES[ord(value)]
+    raise FieldError(
+        f"{where}: expects a byte (bytes of length 1, or 0 to 255), got {_show(value)}"
+    )
+
+
+def _byte_coercer(where: str) -> Callable[[Any], bytes]:
+    return lambda value: to_byte(value, where)
+
+
+def byte_array_coercer(ftype: FieldType, where: str) -> Callable[[Any], list[bytes]]:
+    """Return a function turning user values into a byte array field's list of bytes."""
+
+    def coerce(value: Any) -> list[bytes]:
+        if value is None:
+            items = [_BYTES[0]] * (ftype.size if ftype.array is ArrayKind.FIXED else 0)
+        elif isinstance(value, (bytes, bytearray, memoryview)):
+            items = [_BYTES[b] for b in bytes(value)]
+        elif isinstance(value, np.ndarray) and value.ndim == 1 and value.dtype.kind in "iu":
+            if value.size and (int(value.min()) < -128 or int(value.max()) > 255):
+                raise FieldError(f"{where}: values must lie in 0 to 255 for byte")
+            items = [_BYTES[b] for b in value.astype(np.int64).astype(np.uint8).tobytes()]
+        elif isinstance(value, (list, tuple)):
+            items = [to_byte(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        else:
+            raise FieldError(f"{where}: expects a list of byte, got {_show(value)}")
+        _check_length(ftype, len(items), where)
+        return items
+
+    return coerce
 
 
 def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
@@ -64,9 +120,7 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
     dtype = np.dtype(DTYPES[ftype.base])
     kinds = "b" if ftype.base == "bool" else "iu" if ftype.base in INTEGER_RANGES else "biuf"
     low, high = INTEGER_RANGES.get(ftype.base, (0, 0))
-    if ftype.base == "byte":
-        low = -128
-    eight_bit = ftype.base in ("uint8", "byte", "char")
+    eight_bit = ftype.base in ("uint8", "char")
 
     def coerce(value: Any) -> Any:
         if value is None:
@@ -98,13 +152,8 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
                     raise FieldError(
                         f"{where}: values must lie in {low} to {high} for {ftype.base}"
                     )
-                if ftype.base == "byte":  # 0..255 as ROS writes it, stored as rosbags' int8
-                    raw = (raw.astype(np.int64) & 0xFF).astype(np.uint8)
                 array = raw.astype(dtype)
-        if ftype.array is ArrayKind.FIXED and len(array) != ftype.size:
-            raise FieldError(f"{where}: needs exactly {ftype.size} values, got {len(array)}")
-        if ftype.array is ArrayKind.BOUNDED and len(array) > ftype.size:
-            raise FieldError(f"{where}: holds at most {ftype.size} values, got {len(array)}")
+        _check_length(ftype, len(array), where)
         return array
 
     return coerce
@@ -137,6 +186,22 @@ def build_message_class(
         ftype = field.type
         where = f"{spec.type_name} field '{field.name}'"
         attr = _attr_name(field.name)
+        if ftype.base == "byte":
+            coerce_byte: Callable[[Any], Any] = (
+                byte_array_coercer(ftype, where) if ftype.is_array else _byte_coercer(where)
+            )
+            namespace[f"_d{index}"] = (
+                field.default if ftype.is_array else _scalar_default(ftype, field.default)
+            )
+            slots.append("_" + attr)
+            body[attr] = _array_property("_" + attr, coerce_byte)
+            params.append(f"{attr}={'None' if ftype.is_array else f'_d{index}'}")
+            lines.append(
+                f"    self.{attr} = _d{index} if {attr} is None else {attr}"
+                if ftype.is_array
+                else f"    self.{attr} = {attr}"
+            )
+            continue
         if ftype.is_primitive and ftype.base != "string" and ftype.is_array:
             coerce = array_coercer(ftype, where)
             default = None if field.default is None else list(field.default)
@@ -151,8 +216,9 @@ def build_message_class(
             namespace[f"_d{index}"] = _scalar_default(ftype, field.default)
             params.append(f"{attr}=_d{index}")
             lines.append(f"    self.{attr} = {attr}")
-        elif ftype.is_primitive:  # string arrays
-            default = list(field.default or [""] * ftype.size)
+        elif ftype.is_primitive:  # string arrays: only fixed ones are filled, as in rclpy
+            filled = [""] * ftype.size if ftype.array is ArrayKind.FIXED else []
+            default = list(field.default if field.default is not None else filled)
             namespace[f"_d{index}"] = default
             params.append(f"{attr}=None")
             lines.append(f"    self.{attr} = list(_d{index}) if {attr} is None else {attr}")
@@ -196,10 +262,23 @@ def build_message_class(
         _spec=spec,
     )
     for constant in spec.constants:
-        body[constant.name] = constant.value
+        value = constant.value
+        body[constant.name] = (
+            _BYTES[value & 0xFF] if isinstance(value, int) and (constant.type == "byte") else value
+        )
     for field in spec.fields:
         if field.default is not None:
-            body[f"{field.name.upper()}__DEFAULT"] = field.default
+            default = field.default
+            if field.type.base == "byte":
+                default = (
+                    byte_array_coercer(field.type, "")(default)
+                    if field.type.is_array
+                    else (_scalar_default(field.type, default))
+                )
+            body[f"{field.name.upper()}__DEFAULT"] = default
+    body["_has_bytes"] = any(f.type.base == "byte" for f in spec.fields) or any(
+        getattr(c, "_has_bytes", False) for c in field_classes.values()
+    )
     return type(name.name, (Message,), body)
 
 
@@ -314,6 +393,10 @@ def _convert(message: Message, attr: str, ftype: FieldType, value: Any, where: s
             items.append(element)
         _check_length(ftype, len(items), where)
         return items
+    if ftype.base == "byte":
+        if ftype.is_array:
+            return byte_array_coercer(ftype, where)(value)
+        return to_byte(value, where)
     if ftype.is_array and ftype.base != "string":
         try:
             return array_coercer(ftype, where)(value)
@@ -354,17 +437,17 @@ def convert_scalar(ftype: FieldType, value: Any, where: str) -> Any:
         if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
             raise FieldError(f"{where}: expects a {base} number, got {_show(value)}")
         return float(value)
+    if base == "byte":
+        return to_byte(value, where)
     # integers
     if isinstance(value, float) and value.is_integer():
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise FieldError(f"{where}: expects a whole number ({base}), got {_show(value)}")
     low, high = INTEGER_RANGES[base]
-    if base == "byte":  # rosbags stores byte as a signed 8-bit value
-        low, high = -128, 255
     if not low <= int(value) <= high:
         raise FieldError(f"{where}: {value} is out of range for {base} ({low} to {high})")
-    return int(value) - 256 if base == "byte" and value > 127 else int(value)
+    return int(value)
 
 
 def check_fields(message: Message, path: str = "") -> None:
@@ -388,14 +471,48 @@ def check_fields(message: Message, path: str = "") -> None:
                 if not isinstance(item, Message) or item._fields != cls._fields:
                     raise FieldError(f"{item_where}: expects a {ftype.base}, got {_show(item)}")
                 check_fields(item, item_where)
-        elif ftype.is_array and ftype.base == "string":
+        elif ftype.is_array and ftype.base in ("string", "byte"):
             if not isinstance(value, (list, tuple)):
-                raise FieldError(f"{where}: expects a list of strings, got {_show(value)}")
+                raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
             _check_length(ftype, len(value), where)
             for i, item in enumerate(value):
                 _check_scalar(ftype.element(), item, f"{where}[{i}]")
         elif not ftype.is_array:
             _check_scalar(ftype, value, where)
+
+
+def wire_view(message: Message) -> Any:
+    """Return ``message`` as rosbags' CDR serializer reads it.
+
+    rosbags holds ``byte`` as a signed int8 and a byte array as an int8 numpy array; messages
+    with no byte field anywhere inside are returned as they are.
+
+    Raises:
+        FieldError: a byte field holds something that is not a byte (named by its path).
+    """
+    if not getattr(message, "_has_bytes", False):
+        return message
+    view = SimpleNamespace()
+    for field, attr, ftype in zip(
+        message._spec.fields, message._fields, message._field_types, strict=True
+    ):
+        value = getattr(message, attr)
+        if ftype.base == "byte":
+            where = f"{message.__msgtype__}.{attr}"
+            if not ftype.is_array:
+                value = int.from_bytes(to_byte(value, where), "little", signed=True)
+            else:
+                try:
+                    joined = b"".join(value)
+                except TypeError:
+                    joined = b""
+                if len(joined) != len(value):  # an item set by hand that is not one byte
+                    joined = b"".join(to_byte(v, f"{where}[{i}]") for i, v in enumerate(value))
+                value = np.frombuffer(joined, dtype=np.int8)
+        elif not ftype.is_primitive:
+            value = [wire_view(v) for v in value] if ftype.is_array else wire_view(value)
+        setattr(view, field.name, value)
+    return view
 
 
 def _check_scalar(ftype: FieldType, value: Any, where: str) -> None:

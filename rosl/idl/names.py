@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import difflib
 import re
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from rosl.idl.errors import InterfaceError
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
 
 PACKAGE_NAME = re.compile(r"^(?!.*__)(?!.*_$)[a-z][a-z0-9_]*$")
 FIELD_NAME = PACKAGE_NAME
@@ -83,12 +86,12 @@ def canonical(text: str, default_kind: str = "msg") -> str:
     return str(parse_type_name(text, default_kind))
 
 
-def closest(word: str, candidates: list[str] | tuple[str, ...] | set[str], n: int = 3) -> list[str]:
+def closest(word: str, candidates: Iterable[str], n: int = 3) -> list[str]:
     """Return up to ``n`` candidates close to ``word``, closest first."""
     return difflib.get_close_matches(word, sorted(candidates), n=n, cutoff=0.6)
 
 
-def did_you_mean(word: str, candidates: list[str] | tuple[str, ...] | set[str]) -> str:
+def did_you_mean(word: str, candidates: Iterable[str]) -> str:
     """Return `` (did you mean 'x'?)`` for the closest candidate, or an empty string."""
     found = closest(word, candidates, n=2)
     if not found:

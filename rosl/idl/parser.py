@@ -39,6 +39,11 @@ BUILTIN_ALIASES = {
     "duration": "builtin_interfaces/msg/Duration",
 }
 UNSUPPORTED = ("wstring", "wchar")
+# The largest fixed arrays a definition may declare. A fixed array is filled at construction:
+# 2**26 numbers (64 MiB of uint8, 512 MiB of float64) is far beyond any real message; strings
+# and messages are one Python object each, and the CDR code is written out per element.
+MAX_FIXED_NUMBERS = 2**26
+MAX_FIXED_OBJECTS = 2**16
 SEPARATOR = "---"
 
 
@@ -342,7 +347,18 @@ def parse_field_type(token: str, col: int, ctx: _Context) -> FieldType:
         head, _, bound = base.partition("<=")
         string_bound = _positive(bound, token, col + len(head) + 2, "string bound", ctx)
         base = head
-    return FieldType(_resolve_base(base, col, ctx), array, size, string_bound)
+    resolved = _resolve_base(base, col, ctx)
+    if array is ArrayKind.FIXED:
+        numbers = resolved in PRIMITIVES and resolved != "string"
+        limit = MAX_FIXED_NUMBERS if numbers else MAX_FIXED_OBJECTS
+        if size > limit:
+            kind = "numbers" if numbers else "strings" if resolved == "string" else "messages"
+            raise ctx.error(
+                f"fixed array '{token}' is too large: {size} elements, at most {limit} for "
+                f"{kind} (use a sequence '{token[:open_at]}[]' for big data)",
+                bound_col,
+            )
+    return FieldType(resolved, array, size, string_bound)
 
 
 def _positive(text: str, token: str, col: int, what: str, ctx: _Context) -> int:
@@ -427,17 +443,17 @@ def _parse_scalar(base: str, string_bound: int, text: str, col: int, ctx: _Conte
         except ValueError:
             raise ctx.error(f"value '{text}' is not a number ({base})", col) from None
     # string
-    value = text
+    string = text
     for quote in ('"', "'"):
         if len(text) >= 2 and text[0] == quote and text[-1] == quote:
-            value = text[1:-1].replace("\\" + quote, quote)
+            string = text[1:-1].replace("\\" + quote, quote)
             break
-    if string_bound and len(value) > string_bound:
+    if string_bound and len(string) > string_bound:
         raise ctx.error(
-            f"string value is {len(value)} characters long, more than its bound {string_bound}",
+            f"string value is {len(string)} characters long, more than its bound {string_bound}",
             col,
         )
-    return value
+    return string
 
 
 def _split_strings(inner: str, col: int, ctx: _Context) -> list[str]:

@@ -9,17 +9,19 @@ from __future__ import annotations
 
 import struct
 import threading
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from rosl.idl.errors import FieldError, InterfaceError
-from rosl.idl.messages import DUMMY_FIELD, check_fields
+from rosl.idl.messages import DUMMY_FIELD, check_fields, wire_view
 from rosl.idl.parser import ArrayKind, FieldType
 
 if TYPE_CHECKING:
+    import mmap
+
     from rosl.idl.messages import Message
     from rosl.idl.parser import MessageSpec
 
@@ -71,8 +73,8 @@ class Store:
     def add(self, spec: MessageSpec, cls: type[Message]) -> None:
         """Register a resolved message type and its class (its field types must be added)."""
         with self._lock:
-            self._typestore.fielddefs[spec.type_name] = typesdict_entry(spec)  # type: ignore[assignment]
-            self._typestore.types[spec.type_name] = cls  # type: ignore[assignment]
+            self._typestore.fielddefs[spec.type_name] = typesdict_entry(spec)
+            self._typestore.types[spec.type_name] = cls
             if any(f.type.string_bound or f.type.array is ArrayKind.BOUNDED for f in spec.fields):
                 self._checked.add(spec.type_name)
 
@@ -86,24 +88,33 @@ class Store:
         if type_name in self._checked:
             check_fields(message)
         try:
-            return bytes(self._typestore.serialize_cdr(message, type_name, little_endian=True))
+            wire = wire_view(message)  # byte fields as rosbags holds them
+            return bytes(self._typestore.serialize_cdr(wire, type_name, little_endian=True))
         except _SERIALIZE_ERRORS as err:
             check_fields(message)
             raise FieldError(f"cannot serialize {type_name}: {err}") from err
 
-    def deserialize(self, data: bytes | bytearray | memoryview, type_name: str) -> Message:
+    def deserialize(
+        self, data: bytes | bytearray | memoryview | mmap.mmap, type_name: str
+    ) -> Message:
         """Decode CDR bytes into a message of ``type_name``.
 
         Raises:
             InterfaceError: the bytes are not a valid ``type_name``.
         """
         try:
-            return self._typestore.deserialize_cdr(data, type_name)  # type: ignore[return-value]
+            # rosbags slices any buffer (its hints say bytes | memoryview), and it builds our
+            # classes: add() installed them
+            return cast("Message", self._typestore.deserialize_cdr(cast("bytes", data), type_name))
         except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
             raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
 
     def deserialize_with_schema(
-        self, data: bytes | bytearray | memoryview, type_name: str, encoding: str, text: str
+        self,
+        data: bytes | bytearray | memoryview | mmap.mmap,
+        type_name: str,
+        encoding: str,
+        text: str,
     ) -> Any:
         """Decode CDR bytes with the definition a recording carries (its MCAP schema).
 
@@ -118,7 +129,7 @@ class Store:
         """
         typestore = self._schema_store(type_name, encoding, text)
         try:
-            return typestore.deserialize_cdr(data, type_name)
+            return typestore.deserialize_cdr(cast("bytes", data), type_name)  # any buffer slices
         except Exception as err:  # rosbags raises several kinds for bytes that do not fit
             raise InterfaceError(
                 f"cannot decode {type_name} ({len(data)} bytes) with its schema: "

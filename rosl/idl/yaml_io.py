@@ -57,6 +57,10 @@ def message_to_ordered(
 def _convert(
     value: Any, ftype: FieldType | None, truncate: int | None, no_arr: bool, no_str: bool
 ) -> Any:
+    if isinstance(value, bytes):  # a byte field: its characters, as rosidl_runtime_py shows it
+        if truncate is not None and len(value) > truncate:
+            return "".join(map(chr, value[:truncate])) + "..."
+        return "".join(map(chr, value))
     if isinstance(value, str):
         if no_str:
             return f"<string length: <{len(value)}>>"
@@ -83,7 +87,7 @@ class _Dumper(yaml.SafeDumper):
 
 def dump_yaml(data: Any, *, flow_style: bool = False) -> str:
     """Dump data the way rosidl_runtime_py does (no line wrapping, unicode kept)."""
-    return yaml.dump(  # type: ignore[no-any-return]
+    return yaml.dump(
         data,
         Dumper=_Dumper,
         allow_unicode=True,
@@ -137,6 +141,10 @@ def message_to_csv(
                 return f"<string length: <{len(value)}>>"
             if truncate_length is not None and len(value) > truncate_length:
                 return value[:truncate_length] + "..."
+        if isinstance(value, bytes):  # a byte field prints as b'2'
+            if truncate_length is not None and len(value) > truncate_length:
+                value = value[:truncate_length] + b"..."
+            return str(value)
         if isinstance(value, np.generic):
             value = value.item()
         return str(value)

@@ -19,7 +19,9 @@ if TYPE_CHECKING:
     from collections.abc import Iterator
 
     from rosl.graph.cache import GraphCache
+    from rosl.graph.records import EndpointRecord, NodeRecord
     from rosl.introspection.session import Session
+    from rosl.node.qos import QoSProfile
 
 DEFAULT_TRUNCATE = 128
 
@@ -39,10 +41,26 @@ class EchoOptions:
     timeout: float | None = None
     include_info: bool = False
     count: int | None = None
+    qos: QoSProfile | None = None  # None: matched to the publishers, as ros2 does
+    lost_messages: bool = True
+    raw: bool = False
+
+
+NO_TYPE = "Could not determine the type for the passed topic"
+
+
+def unpublished_warning(topic: str) -> str:
+    """ros2's line (on stdout) for a topic nobody publishes yet."""
+    return f"WARNING: topic [{topic}] does not appear to be published yet"
 
 
 def resolve_type(session: Session, topic: str, type_name: str | None) -> str:
-    """The type to echo: the given one, else the topic's (which must be known and unique)."""
+    """The type to echo: the given one, else the topic's (which must be known and unique).
+
+    Raises:
+        IntrospectionError: ros2's "Could not determine the type for the passed topic" (with
+            the closest published name, if any) for an unknown topic and no type.
+    """
     from rosl.idl.names import canonical, did_you_mean
 
     if type_name:
@@ -51,11 +69,7 @@ def resolve_type(session: Session, topic: str, type_name: str | None) -> str:
         return wanted
     topics = session.graph().topics()
     if topic not in topics:
-        raise IntrospectionError(
-            f"WARNING: topic [{topic}] does not appear to be published yet"
-            f"{did_you_mean(topic, set(topics))}; give its type to wait for it: "
-            f"rosl topic echo {topic} <pkg/msg/Type>"
-        )
+        raise IntrospectionError(NO_TYPE + did_you_mean(topic, set(topics)))
     if len(topics[topic]) > 1:
         raise IntrospectionError(
             f"Cannot echo topic '{topic}', as it contains more than one type: "
@@ -76,17 +90,92 @@ def check_published_type(graph: GraphCache, topic: str, wanted: str) -> None:
         )
 
 
-def select_field(message: Any, path: str | None) -> Any:
-    """Follow ``--field a.b.c`` into a message."""
+def field_parts(path: str | None) -> list[str]:
+    """The names of ``--field a.b.c`` (empty names dropped, as ros2 does).
+
+    Raises:
+        IntrospectionError: ros2's "Invalid field value '.'" when no name is left.
+    """
+    if path is None:
+        return []
+    parts = [part for part in path.split(".") if part]
+    if not parts:
+        raise IntrospectionError(f"Invalid field value '{path}'")
+    return parts
+
+
+def _no_field(value: Any, parts: list[str], part: str) -> IntrospectionError:
+    """ros2's "Invalid field 'a.b': 'Type' object has no attribute 'b'"."""
+    owner = value.__name__ if isinstance(value, type) else type(value).__name__
+    return IntrospectionError(
+        f"Invalid field '{'.'.join(parts)}': '{owner}' object has no attribute '{part}'"
+    )
+
+
+def check_field(msg_type: type[Message], parts: list[str]) -> None:
+    """Refuse, before any message arrives, a ``--field`` naming no field of the type.
+
+    Names past a primitive or an array are left to :func:`select_field`.
+    """
+    cls: type[Message] = msg_type
+    for part in parts:
+        if part not in cls._fields:
+            raise _no_field(cls, parts, part)
+        ftype = cls._field_types[cls._fields.index(part)]
+        if ftype.is_primitive or ftype.is_array:
+            return
+        cls = cls._field_classes[part]
+
+
+def select_field(message: Any, parts: list[str]) -> Any:
+    """Follow ``--field a.b.c`` (as :func:`field_parts` split it) into a message."""
     value = message
-    for part in (path or "").split("."):
-        if not part:
+    for part in parts:
+        if isinstance(value, Message):
+            if part not in value._fields:
+                raise _no_field(value, parts, part)
+            value = getattr(value, part)
             continue
-        if not isinstance(value, Message) or part not in value._fields:
-            fields = ", ".join(value._fields) if isinstance(value, Message) else "(none)"
-            raise IntrospectionError(f"Invalid field '{path}': no '{part}' (fields: {fields})")
-        value = getattr(value, part)
+        try:
+            value = getattr(value, part)
+        except AttributeError as err:  # Python's own words, as ros2 prints them
+            raise IntrospectionError(f"Invalid field '{'.'.join(parts)}': {err}") from None
     return value
+
+
+def matched_qos(
+    publishers: list[tuple[NodeRecord, EndpointRecord]],
+) -> tuple[QoSProfile, list[str]]:
+    """ros2's echo QoS when none is given: reliable/transient-local only if every publisher is.
+
+    Returns:
+        The profile (sensor_data's words, with a deeper queue), and ros2's notes (stdout) when
+        only some publishers offer the stronger policy.
+    """
+    from rosl.node.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
+    notes: list[str] = []
+    offered = [e.qos for _, e in publishers]
+    for key, strong, weak, policy in (
+        ("reliability", "RELIABLE", "BEST_EFFORT", "QoSReliabilityPolicy"),
+        ("durability", "TRANSIENT_LOCAL", "VOLATILE", "QoSDurabilityPolicy"),
+    ):
+        count = sum(1 for words in offered if words.get(key) == strong)
+        if offered and count == len(offered):
+            chosen = strong
+        else:
+            chosen = weak
+            if count:
+                notes.append(
+                    f"Some, but not all, publishers are offering {policy}.{strong}. Falling back "
+                    f"to {policy}.{weak} as it will connect to all publishers"
+                )
+        if key == "reliability":
+            qos.reliability = ReliabilityPolicy[chosen]
+        else:
+            qos.durability = DurabilityPolicy[chosen]
+    return qos, notes
 
 
 def compile_filter(expr: str | None) -> Any:
@@ -165,24 +254,22 @@ def echo(
             within ``--timeout``.
     """
     from rosl.idl.registry import get_message_class
-    from rosl.node.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
+    parts = field_parts(options.field)
+    if type_name is None and topic not in session.graph().topics():
+        yield unpublished_warning(topic)  # then ros2's error, from resolve_type
     resolved = resolve_type(session, topic, type_name)
     msg_type = get_message_class(resolved)
+    check_field(msg_type, [] if options.raw else parts)
     check = compile_filter(options.filter_expr)
-    publishers = session.graph().endpoints(PUBLISHER, topic)
-    transient = bool(publishers) and all(
-        e.qos.get("durability") == "TRANSIENT_LOCAL" for _, e in publishers
-    )
-    qos = QoSProfile(
-        depth=100,
-        reliability=ReliabilityPolicy.BEST_EFFORT,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if transient else DurabilityPolicy.VOLATILE,
-    )
+    qos = options.qos
+    if qos is None:
+        qos, notes = matched_qos(session.graph().endpoints(PUBLISHER, topic))
+        yield from notes
     node = session.node()
     inbox: list[tuple[Any, dict[str, Any]]] = []
     subscription = node.create_subscription(
-        msg_type, topic, lambda m, info: inbox.append((m, info)), qos
+        msg_type, topic, lambda m, info: inbox.append((m, info)), qos, raw=options.raw
     )
     subscription.log_loss = False  # echo says "A message was lost!!!" itself, as ros2 does
     import rosl
@@ -197,14 +284,14 @@ def echo(
             check_published_type(node.participant.graph, topic, resolved)
         executor.spin_once(timeout_sec=0.1)
         lost = subscription.lost
-        if lost > lost_seen:
+        if lost > lost_seen and options.lost_messages:
             change = lost - lost_seen
             yield (
                 f"A message was lost!!!\n\ttotal count change:{change}\n\ttotal count: {lost}\n---"
             )
             lost_seen = lost
         for message, info in inbox:
-            value = select_field(message, options.field)
+            value = select_field(message, parts)
             if check is not None and not run_filter(check, options.filter_expr, value):
                 continue
             yield from _texts(value, info, options)

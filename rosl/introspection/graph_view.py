@@ -18,7 +18,7 @@ from rosl.graph.records import CLIENT, PUBLISHER, SUBSCRIPTION, is_hidden
 from rosl.introspection.errors import IntrospectionError
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from collections.abc import Callable, Iterator
     from pathlib import Path
 
     from rosl.graph.cache import GraphCache
@@ -112,7 +112,9 @@ class GraphModel:
 
 def build(graph: GraphCache, options: GraphOptions, own_process: int | None = None) -> GraphModel:
     """Turn the discovered graph into the picture's model: marks first, then the filters."""
-    shown = (lambda name: True) if options.include_hidden else (lambda name: not is_hidden(name))
+    shown: Callable[[str], bool] = (
+        (lambda name: True) if options.include_hidden else (lambda name: not is_hidden(name))
+    )
     nodes: dict[str, int] = {}
     ends: dict[tuple[str, str], tuple[set[str], set[str], set[str]]] = {}
     for node in graph.nodes():
@@ -150,10 +152,13 @@ def _channel(name: str, kind: str, types: set[str], sources: set[str], sinks: se
 
 
 def _compile(patterns: tuple[str, ...]) -> list[re.Pattern[str]]:
-    try:
-        return [re.compile(p) for p in patterns]
-    except re.error as err:
-        raise IntrospectionError(f"bad regular expression '{err.pattern}': {err.msg}") from None
+    compiled = []
+    for pattern in patterns:
+        try:
+            compiled.append(re.compile(pattern))
+        except re.error as err:
+            raise IntrospectionError(f"bad regular expression '{pattern}': {err.msg}") from None
+    return compiled
 
 
 def _is_debug(name: str) -> bool:

@@ -6,7 +6,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from rosl.introspection import rates
-from rosl.introspection.echo import compile_filter, run_filter
+from rosl.introspection.echo import compile_filter, run_filter, unpublished_warning
 from rosl.introspection.errors import IntrospectionError
 
 if TYPE_CHECKING:
@@ -22,17 +22,42 @@ def _warn_unpublished(session: Session, topics: list[str]) -> Iterator[str]:
     known = session.graph().topics()
     for topic in topics:
         if topic not in known:
-            yield f"WARNING: topic [{topic}] does not appear to be published yet"
+            yield unpublished_warning(topic)
+
+
+def close_names(session: Session, topics: list[str]) -> list[str]:
+    """One stderr hint per unpublished topic with a published name close to it.
+
+    ros2 waits silently for a misspelt topic; rosl keeps waiting too, but says what it may mean.
+    """
+    from rosl.idl.names import did_you_mean
+
+    known = set(session.graph().topics())
+    hints = []
+    for topic in topics:
+        close = "" if topic in known else did_you_mean(topic, known)
+        if close:
+            hints.append(f"no topic {topic} yet{close}; waiting for it")
+    return hints
+
+
+def _wait_published(session: Session, topic: str) -> bool:
+    """Wait (until Ctrl-C or the bus closes) for someone to use ``topic``, as ros2 blocks."""
+    participant = session.participant
+    while topic not in participant.graph.topics():
+        if participant.closed:
+            return False
+        participant.poll(0.1)
+    return True
 
 
 def _decoder(session: Session, topic: str, expr: str) -> Any:
     from rosl.idl.registry import get_message_class, store
 
     check = compile_filter(expr)
-    types = session.graph().topics().get(topic)
-    if not types:
+    if not _wait_published(session, topic):
         raise IntrospectionError(f"--filter needs the type of {topic}, which is not published yet")
-    type_name = types[0]
+    type_name = session.participant.graph.topics()[topic][0]
     get_message_class(type_name)
     serde = store()
 
@@ -77,13 +102,15 @@ def bw(session: Session, topic: str, window: int) -> Iterator[str]:
     participant = session.participant
     tap = rates.Tap(topic, window)
     participant.listen(tap.hash, tap)
+    if not _wait_published(session, topic):
+        return
     yield f"Subscribed to [{topic}]"
     last = time.monotonic()
     while not participant.closed:
         participant.poll(0.1)
         if time.monotonic() - last >= 1.0:
             last = time.monotonic()
-            text = rates.bw_text(tap.window)
+            text = rates.bw_text(tap.window, time.time_ns())
             if text:
                 yield text
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION
+from rosl.introspection.errors import IntrospectionError
 from rosl.introspection.session import visible
 
 if TYPE_CHECKING:
@@ -30,8 +31,17 @@ def list_nodes(
 def node_info(
     session: Session, name: str, *, include_hidden: bool = False
 ) -> tuple[list[str], list[str]]:
-    """(stdout lines, stderr lines) of ``ros2 node info NODE``: the six sections."""
-    found = session.find_node(name)
+    """(stdout lines, stderr lines) of ``ros2 node info NODE``: the six sections.
+
+    As ros2: a hidden node is only found with ``include_hidden``.
+
+    Raises:
+        IntrospectionError: ros2's "Unable to find node '/x'" (with the closest visible name).
+    """
+    fqn = name if name.startswith("/") else "/" + name
+    if not visible(fqn, include_hidden) and session.graph().find_node(fqn):
+        raise IntrospectionError(f"Unable to find node '{fqn}'")  # hidden: ros2's words only
+    found = session.find_node(fqn, visible_only=not include_hidden)
     node = found[0]
     warnings = []
     if len(found) > 1:

@@ -30,8 +30,21 @@ _LABELS = {
 Outcome = tuple[bool, str]  # (succeeded, ros2's line: stdout when it did, stderr when not)
 
 
+NODE_NOT_FOUND = "Node not found"
+
+
 def _fqn(node: str) -> str:
     return node if node.startswith("/") else "/" + node
+
+
+def require_node(session: Session, node: str, *, include_hidden: bool = False) -> None:
+    """Check, before anything else, that ``node`` runs, as every ``ros2 param`` verb does.
+
+    Raises:
+        IntrospectionError: ros2's "Node not found" (with the closest name, if any); a hidden
+            node counts only with ``include_hidden`` (``--include-hidden-nodes``).
+    """
+    session.find_node(_fqn(node), visible_only=not include_hidden, missing=NODE_NOT_FOUND)
 
 
 def _call(session: Session, node: str, service: str, request_values: dict[str, Any]) -> Any:
@@ -39,7 +52,7 @@ def _call(session: Session, node: str, service: str, request_values: dict[str, A
     from rosl.node.client import ServiceTimeoutError
 
     node = _fqn(node)
-    session.find_node(node)
+    session.find_node(node, missing=NODE_NOT_FOUND)
     srv = get_service_class(
         f"rcl_interfaces/srv/{''.join(p.capitalize() for p in service.split('_'))}"
     )
@@ -73,9 +86,26 @@ def types_of(session: Session, node: str, names: list[str]) -> list[ParameterTyp
 
 def _unknown(session: Session, node: str, names: list[str]) -> str:
     """``'a' on /node (did you mean 'b'?)`` for parameters the node does not have."""
+    return f"{', '.join(names)} on {_fqn(node)}{_closest(session, node, names)}"
+
+
+def _closest(session: Session, node: str, names: list[str]) -> str:
+    """`` (did you mean 'b'?)`` for one parameter the node does not have, else nothing."""
     known = set(list_names(session, node))
-    hint = did_you_mean(names[0], known) if len(names) == 1 else ""
-    return f"{', '.join(names)} on {_fqn(node)}{hint}"
+    return did_you_mean(names[0], known) if len(names) == 1 else ""
+
+
+def _humble_text(kind: ParameterType, value: Any) -> str:
+    """A value as ``ros2 param get`` (Humble) prints the message field holding it."""
+    import array
+
+    if kind is ParameterType.INTEGER_ARRAY:
+        return repr(array.array("q", value))  # rclpy's int64[] field
+    if kind is ParameterType.DOUBLE_ARRAY:
+        return repr(array.array("d", value))  # rclpy's float64[] field
+    if kind is ParameterType.BYTE_ARRAY:
+        return str([bytes([b]) for b in value])  # rclpy's byte[] field: one bytes each
+    return str(value)
 
 
 def param_list(
@@ -126,14 +156,13 @@ def param_list(
 def get(session: Session, node: str, name: str, *, hide_type: bool = False) -> str:
     """``ros2 param get``'s line, e.g. ``Double value is: 2.0``."""
     response = _call(session, node, "get_parameters", {"names": [name]})
+    value: Any  # value_from_msg's Python value, None when not set
     kind, value = (
         value_from_msg(response.values[0]) if response.values else (ParameterType.NOT_SET, None)
     )
     if kind is ParameterType.NOT_SET:
-        raise IntrospectionError(f"Parameter not set: {_unknown(session, node, [name])}")
-    if kind is ParameterType.BYTE_ARRAY:
-        value = list(value)
-    text = str(value)
+        raise IntrospectionError("Parameter not set" + _closest(session, node, [name]))
+    text = _humble_text(kind, value)
     return text if hide_type else f"{_LABELS[kind]} {text}"
 
 
@@ -197,7 +226,10 @@ def delete(session: Session, node: str, name: str) -> str:
 
 
 def dump(session: Session, node: str) -> str:
-    """The YAML ``ros2 param dump`` prints: dotted names nested, keys sorted."""
+    """The YAML ``ros2 param dump`` writes: dotted names nested, keys sorted.
+
+    ros2 prints it with ``print``, so on stdout a blank line follows it.
+    """
     import yaml
 
     names = list_names(session, node)
@@ -215,12 +247,22 @@ def dump(session: Session, node: str) -> str:
     return yaml.dump({_fqn(node): {"ros__parameters": tree}}, default_flow_style=False)
 
 
-def dump_to_dir(session: Session, node: str, directory: Path) -> Path:
-    """Write the dump to ``<dir>/<node>.yaml`` (slashes become ``__``)."""
-    path = directory / (_fqn(node).lstrip("/").replace("/", "__") + ".yaml")
+def dump_to_dir(session: Session, node: str, directory: str) -> str:
+    """Write the dump to ``<dir>/<node>.yaml`` (slashes become ``__``); return that path.
+
+    Raises:
+        IntrospectionError: ros2's "'<dir>' is not a valid directory." for a missing folder
+            (checked after the node, as ros2 does), or the file cannot be written.
+    """
+    import os
+
+    if not os.path.isdir(directory):
+        raise IntrospectionError(f"'{directory}' is not a valid directory.")
+    path = os.path.join(directory, _fqn(node).lstrip("/").replace("/", "__") + ".yaml")
+    text = dump(session, node)
     try:
-        directory.mkdir(parents=True, exist_ok=True)
-        path.write_text(dump(session, node), encoding="utf-8")
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
     except OSError as err:
         raise IntrospectionError(f"cannot write {path}: {err.strerror}") from None
     return path
@@ -246,7 +288,7 @@ def file_values(path: Path, node: str, *, use_wildcard: bool = True) -> dict[str
 
 def load(session: Session, node: str, path: Path, *, use_wildcard: bool = True) -> list[Outcome]:
     """Apply a parameter file to a running node; ros2's line per parameter."""
-    session.find_node(_fqn(node))  # as ros2: an unknown node first, then the file
+    require_node(session, node, include_hidden=True)  # as ros2: the node first, then the file
     values = file_values(path, node, use_wildcard=use_wildcard)
     try:
         params = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]

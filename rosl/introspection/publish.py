@@ -22,6 +22,7 @@ if TYPE_CHECKING:
 
     from rosl.idl.base import Message
     from rosl.introspection.session import Session
+    from rosl.node.qos import QoSProfile
 
 HEADER = "std_msgs/msg/Header"
 TIME = "builtin_interfaces/msg/Time"
@@ -38,7 +39,7 @@ class PubOptions:
     wait_matching: int | None = None  # None: 1 with --once/--times, else 0
     max_wait: float = 5.0
     keep_alive: float = 0.1
-    transient_local: bool = False
+    qos: QoSProfile | None = None  # None: reliable, volatile, keep last 10
 
 
 def expand_specials(cls: type[Message], values: Any, now_ns: int) -> Any:
@@ -87,17 +88,12 @@ def publish(
     import rosl
     from rosl.idl.names import canonical
     from rosl.idl.registry import get_message_class
-    from rosl.node.qos import DurabilityPolicy, QoSProfile
+    from rosl.node.qos import QoSProfile
 
     msg_type = get_message_class(canonical(type_name))
     first = build(msg_type, values)  # validate before touching the bus
     node = session.node()
-    qos = QoSProfile(
-        depth=10,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL
-        if options.transient_local
-        else DurabilityPolicy.VOLATILE,
-    )
+    qos = options.qos if options.qos is not None else QoSProfile(depth=10)
     publisher = node.create_publisher(msg_type, topic, qos)
     limited = options.once or options.times > 0
     wait_for = options.wait_matching if options.wait_matching is not None else (1 if limited else 0)
@@ -105,6 +101,8 @@ def publish(
     yield from _check_subscription_types(session, node, topic, wanted, must_match=wait_for > 0)
     if wait_for > 0:
         yield from _wait_subscribers(node, topic, wanted, wait_for, options.max_wait)
+        if not rosl.ok():  # Ctrl-C while waiting
+            return
     yield ("out", "publisher: beginning loop")
     total = 1 if options.once else options.times
     count = 0
@@ -125,7 +123,7 @@ def publish(
         matched, _ = _subscriptions(node, topic, wanted)
         yield ("err", f"sent {count} message(s) to {matched} matched subscription(s) on {topic}")
         end = time.monotonic() + options.keep_alive
-        while time.monotonic() < end:
+        while rosl.ok() and time.monotonic() < end:
             rosl.spin_once(node, timeout_sec=max(0.0, end - time.monotonic()))
 
 
@@ -169,7 +167,7 @@ def _wait_subscribers(
     def matched() -> int:
         return _subscriptions(node, topic, type_name)[0]
 
-    while matched() < wanted:
+    while matched() < wanted and node.context.ok():  # Ctrl-C ends the wait at once
         now = time.monotonic()
         if now >= deadline:
             raise IntrospectionError(

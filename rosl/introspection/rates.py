@@ -9,6 +9,7 @@ of messages lost on the way, printed when there is loss.
 from __future__ import annotations
 
 import math
+import time
 from collections import deque
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -50,6 +51,10 @@ class Window:
             self.sizes.popleft()
             self.stamps.popleft()
         self.count += 1
+        self.note_seq(sender, endpoint, seq)
+
+    def note_seq(self, sender: int, endpoint: int, seq: int) -> None:
+        """Follow one publisher's sequence numbers: a gap is lost messages."""
         previous = self.last_seq.get((sender, endpoint))
         if previous is not None and 0 < seq - previous < 1 << 31:
             self.lost += seq - previous - 1
@@ -78,6 +83,8 @@ class Tap:
         if delivery.kind != Kind.DATA:
             return
         if self.accept is not None and not self.accept(delivery):
+            # filtered out: neither counted nor lost (ros2 skips it in the callback)
+            self.window.note_seq(delivery.sender, delivery.endpoint, delivery.seq)
             return
         self.window.add(
             delivery.received, len(delivery.payload), delivery.sender, delivery.endpoint,
@@ -157,14 +164,21 @@ def _bytes(value: float) -> str:
     return f"{value / 1_000_000:.2f} MB"
 
 
-def bw_text(window: Window) -> str | None:
-    """ros2's bandwidth lines over the window."""
+def bw_text(window: Window, now_ns: int | None = None) -> str | None:
+    """ros2's bandwidth lines: the window's bytes over the time since its first message.
+
+    As ros2's ``bw`` does, the rate divides by ``now - first`` (not ``last - first``), so a
+    topic that stops publishing shows its bandwidth falling.
+    """
     sizes, stamps = window.sizes, window.stamps
     if len(sizes) < 2:
         return None
-    span = (stamps[-1] - stamps[0]) / NS
+    now = time.time_ns() if now_ns is None else now_ns  # receive times are time.time_ns()
+    span = (now - stamps[0]) / NS
+    if span <= 0:
+        return None
     total = sum(sizes)
-    rate = total / span if span > 0 else 0.0
+    rate = total / span
     mean = total / len(sizes)
     return (
         f"{_bytes(rate)}/s from {len(sizes)} messages\n\tMessage size mean: {_bytes(mean)} "

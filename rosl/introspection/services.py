@@ -33,10 +33,14 @@ def list_services(
 
 
 def find_services(session: Session, type_name: str, *, include_hidden: bool = False) -> list[str]:
-    """Services of a type (``pkg/srv/T`` or ``pkg/T``)."""
+    """Services of a type (``pkg/srv/T`` or ``pkg/T``; any other text matches no type)."""
+    from rosl.idl.errors import InterfaceError
     from rosl.idl.names import canonical
 
-    wanted = canonical(type_name, "srv")
+    try:
+        wanted = canonical(type_name, "srv")
+    except InterfaceError:
+        return []  # as ros2: a name that is no type finds nothing
     return [
         n for n, types in session.graph().services().items()
         if wanted in types and visible(n, include_hidden)
@@ -94,40 +98,84 @@ def call(
     Raises:
         IntrospectionError: bad type or values; the service is not there, or does not answer,
             within ``timeout`` seconds.
+        ServiceFailedError: the server's callback raised (its one-line report, at once).
     """
     from rosl.idl.registry import get_service_class
     from rosl.introspection.publish import build
-    from rosl.node.client import ServiceTimeoutError
 
     wanted = resolve_service_type(session, name, type_name)
     srv = get_service_class(wanted)
     request = build(srv.Request, values)
     _check_served_type(session.graph(), name, wanted)
     client = session.node().create_client(srv, name)
+    context = client.node.context  # its first Ctrl-C ends the command (ok() turns false)
     if not client.service_is_ready():
         yield "waiting for service to become available..."
         graph = client.node.participant.graph
-        if not client.wait_for_service(timeout_sec=timeout):
+        if not _wait_service(client, timeout):
+            if not context.ok():
+                return
             raise IntrospectionError(
                 f"service {name} not available after {float(timeout)} s"
                 f"{_suggest(graph, name, wanted)}"
             )
         _check_served_type(graph, name, wanted)
-    while True:
+    while context.ok():
         started = time.monotonic()
         yield f"requester: making request: {request!r}\n"
-        try:
-            response = client.call(request, timeout_sec=timeout)
-        except ServiceTimeoutError:
-            raise IntrospectionError(
-                f"service {name} did not answer within {timeout:g} s (request sent)"
-            ) from None
+        response = _answer(client, name, request, timeout)
+        if response is _INTERRUPTED:
+            return
         yield f"response:\n{response!r}\n"
         if not rate:
             return
-        pause = 1.0 / rate - (time.monotonic() - started)
-        if pause > 0:
-            time.sleep(pause)
+        _pause_until(client.node, started + 1.0 / rate)
+
+
+_INTERRUPTED = object()
+
+
+def _wait_service(client: Any, timeout: float) -> bool:
+    """Wait (bounded, and ended by Ctrl-C) for a server; return whether there is one."""
+    deadline = time.monotonic() + timeout
+    while not client.service_is_ready():
+        left = deadline - time.monotonic()
+        if left <= 0 or not client.node.context.ok():
+            return False
+        client.wait_for_service(timeout_sec=min(left, 0.1))
+    return True
+
+
+def _answer(client: Any, name: str, request: Any, timeout: float) -> Any:
+    """The response to one call; ``_INTERRUPTED`` after Ctrl-C.
+
+    Raises:
+        IntrospectionError: no answer within ``timeout`` seconds.
+        ServiceFailedError: the server's callback raised.
+    """
+    import rosl
+
+    future = client.call_async(request)
+    deadline = time.monotonic() + timeout
+    while not future.done():
+        left = deadline - time.monotonic()
+        if left <= 0 or not client.node.context.ok():
+            client.remove_pending_request(future)
+            if left > 0:
+                return _INTERRUPTED
+            raise IntrospectionError(
+                f"service {name} did not answer within {timeout:g} s (request sent)"
+            )
+        rosl.spin_once(client.node, timeout_sec=min(left, 0.1))
+    return future.result()
+
+
+def _pause_until(node: Any, when: float) -> None:
+    """Serve the node until ``when`` (monotonic), or until Ctrl-C."""
+    import rosl
+
+    while node.context.ok() and (left := when - time.monotonic()) > 0:
+        rosl.spin_once(node, timeout_sec=min(left, 0.1))
 
 
 def echo(

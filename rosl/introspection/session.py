@@ -103,13 +103,21 @@ class Session:
             )
         return services[service]
 
-    def find_node(self, fqn: str) -> list[NodeRecord]:
-        """Nodes called ``fqn`` (a leading '/' is added); error with close names if none."""
+    def find_node(
+        self, fqn: str, *, visible_only: bool = False, missing: str = "Unable to find node '{}'"
+    ) -> list[NodeRecord]:
+        """Nodes called ``fqn`` (a leading '/' is added); error with close names if none.
+
+        Args:
+            fqn: the node's full name.
+            visible_only: a hidden node (a name token starting with '_') counts as missing.
+            missing: the error's words, ``{}`` standing for the name (ros2's differ by verb).
+        """
         name = fqn if fqn.startswith("/") else "/" + fqn
         found = self.graph().find_node(name)
-        if not found:
-            names = {n.fqn for n in self.graph().nodes()}
-            raise IntrospectionError(f"Unable to find node '{name}'{did_you_mean(name, names)}")
+        if not found or (visible_only and not visible(name, False)):
+            names = {n.fqn for n in self.graph().nodes() if visible(n.fqn, not visible_only)}
+            raise IntrospectionError(missing.format(name) + did_you_mean(name, names))
         return found
 
 

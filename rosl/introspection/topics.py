@@ -46,10 +46,14 @@ def _verbose_section(
 
 
 def find_topics(session: Session, type_name: str, *, include_hidden: bool = False) -> list[str]:
-    """Topics carrying ``type_name`` (``pkg/msg/T`` or ``pkg/T``)."""
+    """Topics carrying ``type_name`` (``pkg/msg/T`` or ``pkg/T``; other text matches none)."""
+    from rosl.idl.errors import InterfaceError
     from rosl.idl.names import canonical
 
-    wanted = canonical(type_name)
+    try:
+        wanted = canonical(type_name)
+    except InterfaceError:
+        return []  # as ros2: a name that is no type finds nothing
     return [
         name
         for name, types in session.graph().topics().items()
@@ -57,8 +61,10 @@ def find_topics(session: Session, type_name: str, *, include_hidden: bool = Fals
     ]
 
 
-def topic_info(session: Session, topic: str, *, verbose: bool = False) -> list[str]:
-    """The lines ``ros2 topic info [-v]`` prints, plus rosl's loss counters with ``-v``."""
+def topic_info(
+    session: Session, topic: str, *, verbose: bool = False, stats: bool = False
+) -> list[str]:
+    """The lines ``ros2 topic info [-v]`` prints; ``stats`` adds each endpoint's counters."""
     types = session.topic_types(topic)
     graph = session.graph()
     end = "\n" if verbose else ""
@@ -68,14 +74,14 @@ def topic_info(session: Session, topic: str, *, verbose: bool = False) -> list[s
     subs = sorted_endpoints(graph.endpoints(SUBSCRIPTION, topic))
     lines.append(f"Publisher count: {len(pubs)}{end}")
     if verbose:
-        lines += [_endpoint_block(node, e) + "\n" for node, e in pubs]
+        lines += [_endpoint_block(node, e, stats) + "\n" for node, e in pubs]
     lines.append(f"Subscription count: {len(subs)}{end}")
     if verbose:
-        lines += [_endpoint_block(node, e) + "\n" for node, e in subs]
+        lines += [_endpoint_block(node, e, stats) + "\n" for node, e in subs]
     return lines
 
 
-def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord) -> str:
+def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord, stats: bool) -> str:
     qos = endpoint.qos
     history = qos.get("history", "KEEP_LAST")
     depth = f"{history} ({qos.get('depth', 0)})" if history == "KEEP_LAST" else history
@@ -94,12 +100,14 @@ def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord) -> str:
         f"  Liveliness: {qos.get('liveliness', 'AUTOMATIC')}",
         "  Liveliness lease duration: Infinite",
     ]
-    stats = endpoint.stats
+    if not stats:
+        return "\n".join(lines)
+    counts = endpoint.stats
     if endpoint.kind == PUBLISHER:
-        lines.append(f"Messages sent: {stats.get('sent', 0)}")
+        lines.append(f"Messages sent: {counts.get('sent', 0)}")
     else:
         lines.append(
-            f"Messages received: {stats.get('received', 0)} "
-            f"(lost: {stats.get('lost', 0)}, wrong type: {stats.get('mismatched', 0)})"
+            f"Messages received: {counts.get('received', 0)} "
+            f"(lost: {counts.get('lost', 0)}, wrong type: {counts.get('mismatched', 0)})"
         )
     return "\n".join(lines)

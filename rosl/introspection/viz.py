@@ -3,8 +3,10 @@
 Messages are taken in time order: ``/tf`` and ``/tf_static`` fill a TF buffer, odometry
 messages add to each robot's path, the world's markers (``/world_markers``) give the
 obstacles, and each LaserScan is placed with the TF known at its time (the last one is drawn).
-Everything is then expressed in the fixed frame (``odom`` by default, as the tutorial sets
-RViz) and drawn by :mod:`rosl.sim.render`.
+Everything is then expressed in the fixed frame and drawn by :mod:`rosl.sim.render`. The
+fixed frame is ``odom`` by default, as the tutorial sets RViz; when the TF tree has no ``odom``
+(Dolly's odometry is in ``odom_demo``), the frame the odometry is given in is taken instead,
+and :attr:`VizBuilder.note` says which.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ TF = "tf2_msgs/msg/TFMessage"
 MARKERS = "visualization_msgs/msg/MarkerArray"
 STRING = "std_msgs/msg/String"
 KINDS = (ODOMETRY, SCAN, TF, MARKERS, STRING)
+DEFAULT_FRAME = "odom"
 Point = tuple[float, float]
 
 
@@ -43,8 +46,10 @@ def _yaw(transform: Transform) -> float:
 class VizBuilder:
     """Collects messages (in time order) and turns them into a :class:`Scene`."""
 
-    def __init__(self, fixed_frame: str = "odom") -> None:
-        self.fixed = fixed_frame
+    def __init__(self, fixed_frame: str | None = None) -> None:
+        self.requested = fixed_frame  # None: odom, or the odometry's frame when there is no odom
+        self.fixed = fixed_frame or DEFAULT_FRAME
+        self.note: str | None = None  # how the fixed frame was chosen, when not as asked
         self.tf = TfBuffer()
         self.paths: dict[str, list[tuple[str, float, float]]] = {}  # topic -> (frame, x, y)
         self.last_pose: dict[str, tuple[str, Transform]] = {}
@@ -86,6 +91,7 @@ class VizBuilder:
 
     def _scan(self, message: Any) -> None:
         frame = message.header.frame_id.lstrip("/")
+        self.choose_fixed_frame()
         where = self._to_fixed(frame)
         if where is None:
             return
@@ -109,8 +115,40 @@ class VizBuilder:
                 p = marker.pose.position
                 self.circles.append((frame, (p.x, p.y), marker.scale.x / 2))
 
+    def choose_fixed_frame(self) -> str:
+        """The fixed frame: as asked, else ``odom``, else the frame odometry is given in.
+
+        Without ``odom`` in the TF tree, the first odometry topic's frame (by topic name) that
+        the tree knows is taken, and :attr:`note` says so and names the other candidates.
+        Asked again as messages arrive, so each scan is placed in the frame known by then.
+        """
+        if self.requested is not None:
+            return self.fixed
+        self.fixed, self.note = DEFAULT_FRAME, None
+        known = self.tf.frames()
+        if DEFAULT_FRAME in known:
+            return self.fixed
+        candidates: dict[str, list[str]] = {}
+        for topic in sorted(self.last_pose):
+            frame = self.last_pose[topic][0]
+            if frame and (not known or frame in known):
+                candidates.setdefault(frame, []).append(topic)
+        if not candidates or DEFAULT_FRAME in candidates:
+            return self.fixed
+        chosen, *others = candidates
+        self.fixed = chosen
+        note = (
+            f"fixed frame: {chosen} (there is no '{DEFAULT_FRAME}' frame; {chosen} is the frame "
+            f"of {', '.join(candidates[chosen])}"
+        )
+        if others:
+            also = ", ".join(f"{frame} ({', '.join(candidates[frame])})" for frame in others)
+            note += f"; other odometry frames: {also}; pick one with --fixed-frame"
+        self.note = note + ")"
+        return chosen
+
     def scene(self, title: str) -> Scene:
-        """Everything collected, in the fixed frame.
+        """Everything collected, in the fixed frame (see :meth:`choose_fixed_frame`).
 
         Raises:
             IntrospectionError: nothing drawable arrived, or the fixed frame is unknown.
@@ -120,6 +158,7 @@ class VizBuilder:
                 "nothing to draw: no odometry, LaserScan or /world_markers messages "
                 f"(read {self.count} messages)"
             )
+        self.choose_fixed_frame()
         known = self.tf.frames()
         if known and self.fixed not in known:
             raise IntrospectionError(
@@ -161,8 +200,8 @@ class VizBuilder:
         return scene
 
 
-def rviz_fixed_frame(config: Path) -> str:
-    """The Fixed Frame an RViz config file (``rviz2 -d FILE``) names; ``odom`` if it names none.
+def rviz_fixed_frame(config: Path) -> str | None:
+    """The Fixed Frame an RViz config file (``rviz2 -d FILE``) names; None if it names none.
 
     Raises:
         IntrospectionError: the file cannot be read or is not an RViz (YAML) config.
@@ -182,11 +221,14 @@ def rviz_fixed_frame(config: Path) -> str:
         raise IntrospectionError(f"{config}: not an RViz config (no 'Visualization Manager')")
     options = manager.get("Global Options")
     frame = options.get("Fixed Frame") if isinstance(options, dict) else None
-    return str(frame) if frame else "odom"
+    return str(frame) if frame else None
 
 
-def from_bag(bag: Path, fixed_frame: str) -> VizBuilder:
-    """Read the drawable topics of a bag (folder or .mcap file) in time order."""
+def from_bag(bag: Path, fixed_frame: str | None) -> VizBuilder:
+    """Read the drawable topics of a bag (folder or .mcap file) in time order.
+
+    ``fixed_frame`` None: ``odom``, or the odometry's own frame when there is no ``odom``.
+    """
     from rosl.bag.reader import iter_bag
     from rosl.idl import registry
 
@@ -201,13 +243,14 @@ def from_bag(bag: Path, fixed_frame: str) -> VizBuilder:
     return builder
 
 
-def live(session: Session, fixed_frame: str, seconds: float) -> VizBuilder:
+def live(session: Session, fixed_frame: str | None, seconds: float) -> VizBuilder:
     """Listen to the drawable topics on the bus for ``seconds``.
 
     Late-joining is fine: /tf_static and /world_markers keep their history for new listeners.
     """
     import rosl
     from rosl.graph.records import PUBLISHER
+    from rosl.idl.registry import get_message_class
     from rosl.node.qos import DurabilityPolicy, QoSProfile
 
     builder = VizBuilder(fixed_frame)
@@ -221,7 +264,7 @@ def live(session: Session, fixed_frame: str, seconds: float) -> VizBuilder:
             qos = QoSProfile(depth=1000, durability=DurabilityPolicy.TRANSIENT_LOCAL if latched
                              else DurabilityPolicy.VOLATILE)  # fmt: skip
             node.create_subscription(
-                rosl.get_interface(endpoint.type), endpoint.name,
+                get_message_class(endpoint.type), endpoint.name,
                 _taker(builder, endpoint.name, endpoint.type), qos,
             )  # fmt: skip
     if not subscribed:

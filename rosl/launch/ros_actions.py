@@ -154,8 +154,8 @@ class Node(ExecuteProcess):
                 "--params-file",
                 str(context.supervisor.parameter_file(self._label(context), values)),
             ]
-        for path in files:
-            args += ["--params-file", path]
+        for params_file in files:
+            args += ["--params-file", params_file]
         return args, values
 
     def _label(self, context: LaunchContext) -> str:

@@ -80,22 +80,26 @@ def launch(
             last one exits, into this folder.
     """
     chosen = supervisor or Supervisor()
-    chosen.log("INFO", "launch", f"All log files can be found below {chosen.log_dir}")
-    chosen.log("INFO", "launch", "Default logging verbosity is set to INFO")
-    if record is not None:
-        start_recorder(chosen, record)
-    context = LaunchContext(chosen, arguments)
-    context.files.append(path)
-    os.environ.setdefault("PYTHONUNBUFFERED", "1")
+    chosen.install_signal_handlers()  # a Ctrl-C from here on stops whatever has started
     try:
-        description = load_description(path)
-        check_required_arguments(description, context, path)
-        process(description.entities, context)
-    except BaseException:
-        chosen.shutdown("launch file failed")
-        chosen.run()
-        raise
-    return chosen.run()
+        chosen.log("INFO", "launch", f"All log files can be found below {chosen.log_dir}")
+        chosen.log("INFO", "launch", "Default logging verbosity is set to INFO")
+        if record is not None:
+            start_recorder(chosen, record)
+        context = LaunchContext(chosen, arguments)
+        context.files.append(path)
+        os.environ.setdefault("PYTHONUNBUFFERED", "1")
+        try:
+            description = load_description(path)
+            check_required_arguments(description, context, path)
+            process(description.entities, context)
+        except BaseException:
+            chosen.shutdown("launch file failed")
+            chosen.run()
+            raise
+        return chosen.run()
+    finally:
+        chosen.restore_signal_handlers()
 
 
 def start_recorder(supervisor: Supervisor, folder: Path) -> None:
@@ -109,12 +113,14 @@ def start_recorder(supervisor: Supervisor, folder: Path) -> None:
     from rosl.launch.errors import LaunchError
     from rosl.launch.supervisor import ProcessSpec
 
-    cmd = [sys.executable, "-m", "rosl", "bag", "record", "-a", "--include-services",
+    cmd = [sys.executable, "-P", "-m", "rosl", "bag", "record", "-a", "--include-services",
            "-o", str(folder)]  # fmt: skip
     spec = ProcessSpec(name="rosbag2_recorder", cmd=cmd, env=dict(os.environ), output="screen",
                        background=True, sigterm_timeout=10.0, sigkill_timeout=5.0)  # fmt: skip
     label = supervisor.start(spec, None, None)
-    if not supervisor.wait_for_line(label, "Recording to", timeout=10.0):
+    if not supervisor.wait_for_line(label, "Recording to", timeout=10.0) and not (
+        supervisor.stopping  # Ctrl-C meanwhile: nothing more starts, the recorder is stopped
+    ):
         supervisor.shutdown("the recorder did not start")
         supervisor.run()
         raise LaunchError("the recorder did not start (its output is above); nothing was launched")

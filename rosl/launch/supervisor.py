@@ -25,9 +25,10 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any, cast
 
 from rosl.launch.errors import LaunchError
+from rosl.pkg import interrupts
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -38,8 +39,9 @@ _COLORS = ["\033[32m", "\033[34m", "\033[35m", "\033[36m", "\033[33m", "\033[92m
 _PR_SET_PDEATHSIG = 1
 
 
-def _die_with_parent() -> None:  # runs in the child between fork and exec
-    with contextlib.suppress(OSError, AttributeError):
+def _prepare_child(hold_sigint: bool) -> None:  # runs in the child between fork and exec
+    interrupts.prepare_child(hold_sigint)
+    with contextlib.suppress(OSError, AttributeError):  # die with the launcher
         ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
@@ -113,11 +115,13 @@ class Supervisor:
         self._handlers: list[tuple[Any, LaunchContext]] = []
         self._timers: list[tuple[float, int, Callable[[], None]]] = []
         self._timer_ids = itertools.count()
-        self._respawns: list[tuple[float, int, ProcessSpec, Any, LaunchContext, str]] = []
+        self._respawns: list[tuple[float, int, ProcessSpec, Any, LaunchContext | None, str]] = []
         self._selector = selectors.DefaultSelector()
         self._shutdown_reason: str | None = None
         self._log_file: IO[str] | None = None
         self._interrupts = 0
+        self._previous_handlers: dict[int, Any] | None = None
+        self._signals: list[int] = []  # received, not yet handled
         self._watch: tuple[str, str] | None = None
         self._seen = False
 
@@ -175,16 +179,18 @@ class Supervisor:
         """Start a process (or, in a dry run, just record it); return its ``name-N`` label."""
         self.planned.append(spec)
         label = label or f"{spec.name}-{next(self._counter)}"
+        self._handle_signals()  # a Ctrl-C meanwhile: start nothing more
         if self.dry_run or self._shutdown_reason is not None:
             return label
-        env = {**spec.env, "PYTHONUNBUFFERED": "1"}
+        env = interrupts.child_environment(spec.cmd, {**spec.env, "PYTHONUNBUFFERED": "1"})
         if spec.emulate_tty and self.color:
             env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
+        hold = interrupts.HELD in env
         try:
             popen = subprocess.Popen(
                 spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
-                preexec_fn=_die_with_parent,
+                preexec_fn=lambda: _prepare_child(hold),
             )  # fmt: skip
         except OSError as err:
             self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
@@ -207,7 +213,7 @@ class Supervisor:
         deadline = time.monotonic() + timeout
         self._watch = (label, text)
         self._seen = False
-        while not self._seen and time.monotonic() < deadline:
+        while not self._seen and time.monotonic() < deadline and not self.stopping:
             if not any(r.label == label for r in self._running):
                 break
             self._step()
@@ -231,6 +237,11 @@ class Supervisor:
 
     # --- the loop ----------------------------------------------------------------------------
 
+    @property
+    def stopping(self) -> bool:
+        """Whether the launch is shutting down (Ctrl-C, or its work is done)."""
+        return self._shutdown_reason is not None
+
     def shutdown(self, reason: str) -> None:
         """Stop every process (SIGINT, then escalation) and start nothing more."""
         if self._shutdown_reason is not None:
@@ -252,6 +263,15 @@ class Supervisor:
                 running.popen.send_signal(signum)
 
     def _on_signal(self, signum: int, frame: Any) -> None:
+        # only noted here: the handler may run in the middle of a write to the same stream
+        # or launch.log, and a reentrant write raises; handled by the loop and by start()
+        self._signals.append(signum)
+
+    def _handle_signals(self) -> None:
+        while self._signals:
+            self._handle_signal(self._signals.pop(0))
+
+    def _handle_signal(self, signum: int) -> None:
         self._interrupts += 1
         name = "SIGINT" if signum == signal.SIGINT else "SIGTERM"
         if self._interrupts == 1:
@@ -266,37 +286,62 @@ class Supervisor:
             for running in self._running:
                 self._signal(running, signal.SIGKILL if self._interrupts > 2 else signal.SIGTERM)
 
+    def install_signal_handlers(self) -> None:
+        """Take SIGINT and SIGTERM from now on, whatever this process inherited.
+
+        A background job of a shell starts with SIGINT ignored; the launcher takes it anyway
+        (as ``ros2 launch`` does), so one ``kill -INT`` always ends the launch.
+        """
+        if self._previous_handlers is None:
+            self._previous_handlers = {
+                s: signal.signal(s, self._on_signal) for s in (signal.SIGINT, signal.SIGTERM)
+            }
+
+    def restore_signal_handlers(self) -> None:
+        """Give SIGINT and SIGTERM back to what they were before."""
+        previous, self._previous_handlers = self._previous_handlers, None
+        for sig, handler in (previous or {}).items():
+            signal.signal(sig, handler)
+
     def run(self) -> int:
         """Supervise until every process is gone; return the launch's exit status."""
-        previous = {s: signal.signal(s, self._on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+        installed_here = self._previous_handlers is None
+        self.install_signal_handlers()
         try:
             while self._running or (
                 self._shutdown_reason is None and (self._timers or self._respawns)
             ):
+                self._handle_signals()
                 foreground = [r for r in self._running if not r.spec.background]
                 pending = self._timers or self._respawns
                 if self._shutdown_reason is None and not foreground and not pending:
                     self.shutdown("all processes have finished")
-                if self._shutdown_reason is not None and not foreground:
-                    for helper in self._running:  # the last one left: stop the helpers now
-                        if not helper.stopping:
-                            self._signal(helper, signal.SIGINT)
+                if self._shutdown_reason is not None:
+                    # started while the Ctrl-C was being handled: stop it too
+                    for running in foreground:
+                        if not running.stopping:
+                            self._signal(running, signal.SIGINT)
+                    if not foreground:
+                        for helper in self._running:  # the last one left: stop the helpers now
+                            if not helper.stopping:
+                                self._signal(helper, signal.SIGINT)
                 self._step()
         finally:
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
             self.kill_all()
+            if installed_here:
+                self.restore_signal_handlers()
             if self._log_file is not None:
                 self._log_file.close()
         return 1 if self.failed else 0
 
     def _step(self) -> None:
+        self._handle_signals()
         now = time.monotonic()
         wait = 0.1
         if self._timers:
             wait = min(wait, max(0.0, self._timers[0][0] - now))
         for key, _ in self._selector.select(wait):
-            self._read(key.fileobj, key.data)  # type: ignore[arg-type]
+            self._read(cast("IO[bytes]", key.fileobj), key.data)  # only pipes are registered
         now = time.monotonic()
         while self._timers and self._timers[0][0] <= now and self._shutdown_reason is None:
             _, _, function = heapq.heappop(self._timers)

@@ -38,6 +38,7 @@ from rosl.launch.substitutions import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Hashable
     from pathlib import Path
 
 _TOKEN = re.compile(r"\$\(([a-z_-]+)(?:\s+([^)]*))?\)")
@@ -63,7 +64,7 @@ class _Loader(yaml.SafeLoader):
     """A safe loader that remembers the line of every mapping."""
 
 
-def _mapping_with_line(loader: _Loader, node: yaml.MappingNode) -> dict[str, Any]:
+def _mapping_with_line(loader: _Loader, node: yaml.MappingNode) -> dict[Hashable, Any]:
     mapping = loader.construct_mapping(node, deep=True)
     mapping[LINE] = node.start_mark.line + 1
     return mapping
@@ -131,8 +132,9 @@ class _Reader:
             if not isinstance(item, dict) or len([k for k in item if k != LINE]) != 1:
                 raise self.fail(line, "each launch entry is a single key such as 'node:' or 'arg:'")
             kind = next(k for k in item if k != LINE)
-            entry = item[kind] if isinstance(item[kind], dict) else {}
-            where = entry.get(LINE, item.get(LINE, line))
+            entry: dict[str, Any] = item[kind] if isinstance(item[kind], dict) else {}
+            item_line: int = item.get(LINE, line)
+            where: int = entry.get(LINE, item_line)
             method = getattr(self, "entry_" + kind.replace("-", "_"), None)
             if method is None:
                 raise self.fail(

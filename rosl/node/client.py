@@ -1,5 +1,7 @@
 """Service clients: requests out, responses matched by sequence number; every wait bounded.
 
+A server whose callback raised answers with a failure, which fails the call at once.
+
 ``call`` works inside a callback too: it reads only its own channel while it waits and
 queues anything else it reads for the executor, so nothing deadlocks and nothing is lost.
 """
@@ -16,6 +18,7 @@ from rosl.graph.records import CLIENT, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
 from rosl.node.errors import NodeError
+from rosl.node.service import failure_text
 
 if TYPE_CHECKING:
     from rosl.bus.wire import Delivery
@@ -23,8 +26,20 @@ if TYPE_CHECKING:
     from rosl.node.node import Node
 
 
+_ANSWERS = (Kind.RESPONSE, Kind.FAILURE)
+
+
 class ServiceTimeoutError(NodeError, TimeoutError):
     """A service did not become available, or did not answer, in time."""
+
+
+class ServiceFailedError(NodeError, RuntimeError):
+    """The server's callback raised while handling the request (the server says which error)."""
+
+    def __init__(self, service: str, error: str) -> None:
+        super().__init__(f"service {service} failed: {error}")
+        self.service = service
+        self.error = error  # "ZeroDivisionError: division by zero"
 
 
 class Client:
@@ -63,7 +78,11 @@ class Client:
     # --- calling -----------------------------------------------------------------------------
 
     def call_async(self, request: Any) -> Future:
-        """Send a request; the returned Future completes with the response."""
+        """Send a request; the returned Future completes with the response.
+
+        When the server's callback raises, the future fails instead: ``exception()`` is a
+        :class:`ServiceFailedError` and ``result()`` raises it.
+        """
         expected = self.srv_type.Request.__msgtype__
         if getattr(request, "__msgtype__", None) != expected:
             raise TypeError(
@@ -79,6 +98,7 @@ class Client:
 
         Raises:
             ServiceTimeoutError: no response within ``timeout_sec`` (None waits without limit).
+            ServiceFailedError: the server's callback raised (reported at once).
         """
         future = self.call_async(request)
         deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
@@ -109,7 +129,7 @@ class Client:
     def _mine(self, delivery: Delivery) -> bool:
         address = delivery.address
         return (
-            delivery.kind == Kind.RESPONSE
+            delivery.kind in _ANSWERS
             and address is not None
             and address[0] == self._sender
             and address[1] == self.endpoint
@@ -121,6 +141,9 @@ class Client:
             return
         future = self._pending.pop(delivery.address[2], None)
         if future is None:
+            return
+        if delivery.kind == Kind.FAILURE:
+            future.set_exception(ServiceFailedError(self.srv_name, failure_text(delivery.payload)))
             return
         try:
             response = self._store.deserialize(delivery.payload, self.srv_type.Response.__msgtype__)

@@ -112,7 +112,7 @@ class Time:
 
     def seconds_nanoseconds(self) -> tuple[int, int]:
         """(seconds, nanoseconds within the second)."""
-        return divmod(self._ns, NS)  # type: ignore[return-value]
+        return divmod(self._ns, NS)
 
     def to_msg(self) -> Any:
         """Return a builtin_interfaces/msg/Time."""

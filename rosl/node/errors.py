@@ -40,5 +40,9 @@ class InvalidParameterTypeException(InvalidParameterValueException):
     """Raised when a value's type differs from the parameter's declared type."""
 
 
+class TimerPeriodError(NodeError, ValueError):
+    """A timer period that is not a finite number of seconds > 0 (or past int64 nanoseconds)."""
+
+
 class NotInitializedError(NodeError):
     """rosl.init() was not called (or the context is shut down)."""

@@ -171,7 +171,7 @@ class LockstepSource:
         from rosl.idl import registry
 
         try:
-            ack = registry.store().deserialize(delivery.payload, TYPE)
+            ack: Any = registry.store().deserialize(delivery.payload, TYPE)  # fields by name
         except Exception:
             return
         if ack.source != self.participant.sender:

@@ -95,6 +95,9 @@ class Node:
         self._events = self._publisher_for(
             "rcl_interfaces/msg/ParameterEvent", "/parameter_events", qos_profile_parameter_events
         )
+        self._parameters.on_callback_error = lambda err: self._callback_failed(
+            err, "on_set_parameters"
+        )
         self._parameters.add_callback(self._on_use_sim_time)
         sim_time = self.declare_parameter("use_sim_time", False)
         self._set_sim_time(sim_time.type_ is ParameterType.BOOL and bool(sim_time.value))
@@ -204,11 +207,23 @@ class Node:
         callback_group: Any = None,
         clock: Clock | None = None,
     ) -> Timer:
-        """Call ``callback`` every ``timer_period_sec`` seconds of this node's clock."""
-        from rosl.node.timer import Timer
+        """Call ``callback`` every ``timer_period_sec`` seconds of this node's clock.
+
+        Raises:
+            TimerPeriodError: the period is not a finite number of seconds > 0 (a parameter
+                holding that value is named).
+        """
+        from rosl.node.errors import TimerPeriodError
+        from rosl.node.timer import Timer, seconds_to_period_ns
 
         del callback_group
-        timer = Timer(callback, round(timer_period_sec * NS), clock or self._clock)
+        try:
+            period = seconds_to_period_ns(timer_period_sec)
+        except TimerPeriodError as err:
+            held = self._parameters.holding(timer_period_sec)
+            hint = f" (the value of parameter '{held[0]}')" if len(held) == 1 else ""
+            raise TimerPeriodError(f"{err}{hint}") from None
+        timer = Timer(callback, period, clock or self._clock, self.participant.wake)
         self.timers.append(timer)
         self.participant.wake()
         return timer
@@ -374,17 +389,21 @@ class Node:
         except (KeyboardInterrupt, SystemExit):
             raise
         except Exception as err:
-            if self.context.callback_errors == "raise":
-                raise
-            every = traceback.extract_tb(err.__traceback__)
-            frames = [f for f in every if not f.filename.startswith(_ROSL_DIR)] or every
-            where = frames[-1]
-            self._logger.error(
-                f"exception in callback for {what}: {type(err).__name__}: {err} "
-                f"(at {where.filename}:{where.lineno} in {where.name}); the node keeps running"
-            )
-            lines = traceback.format_list(frames) + traceback.format_exception_only(err)
-            sys.stderr.write("Traceback (most recent call last):\n" + "".join(lines))
+            self._callback_failed(err, what)
+
+    def _callback_failed(self, err: Exception, what: str) -> None:
+        """Log a user callback's exception and its line (re-raised in ``raise`` mode)."""
+        if self.context.callback_errors == "raise":
+            raise err
+        every = traceback.extract_tb(err.__traceback__)
+        frames = [f for f in every if not f.filename.startswith(_ROSL_DIR)] or every
+        where = frames[-1]
+        self._logger.error(
+            f"exception in callback for {what}: {type(err).__name__}: {err} "
+            f"(at {where.filename}:{where.lineno} in {where.name}); the node keeps running"
+        )
+        lines = traceback.format_list(frames) + traceback.format_exception_only(err)
+        sys.stderr.write("Traceback (most recent call last):\n" + "".join(lines))
 
     def _check_duplicate_name(self) -> None:
         self.destroy_timer(self._name_check)
@@ -502,8 +521,10 @@ class Node:
 
     def record(self) -> NodeRecord:
         """This node as discovery announces it."""
-        endpoints = [e.record() for e in (*self.publishers, *self.subscriptions, *self.services,
-                                          *self.clients) if not e.destroyed]  # fmt: skip
+        entities: list[Publisher | Subscription | Service | Client] = [
+            *self.publishers, *self.subscriptions, *self.services, *self.clients
+        ]  # fmt: skip
+        endpoints = [e.record() for e in entities if not e.destroyed]
         return NodeRecord(
             self._name, self._namespace, self.participant.sender, self.index, tuple(endpoints)
         )

@@ -210,8 +210,13 @@ def value_from_msg(msg: Any) -> tuple[ParameterType, Any]:
     if hasattr(value, "tolist"):
         value = value.tolist()
     if kind is ParameterType.BYTE_ARRAY:
-        value = bytes(v & 0xFF for v in value)
+        value = _to_bytes(value)
     return kind, value
+
+
+def _to_bytes(values: Any) -> bytes:
+    """A byte array as one ``bytes``: from rclpy's list of 1-byte ``bytes``, or of 0..255."""
+    return b"".join(v if isinstance(v, bytes) else bytes((int(v) & 0xFF,)) for v in values)
 
 
 def _normalize(kind: ParameterType, value: Any) -> Any:
@@ -221,8 +226,8 @@ def _normalize(kind: ParameterType, value: Any) -> Any:
         return [float(v) for v in value]
     if kind is ParameterType.DOUBLE and isinstance(value, int):
         return float(value)
-    if kind is ParameterType.BYTE_ARRAY and isinstance(value, list):
-        return bytes(value)
+    if kind is ParameterType.BYTE_ARRAY and isinstance(value, (list, tuple)):
+        return _to_bytes(value)
     return value
 
 
@@ -259,7 +264,7 @@ class Descriptor:
         """Return an rcl_interfaces/msg/ParameterDescriptor."""
         from rosl.idl.registry import get_message_class
 
-        msg = get_message_class("rcl_interfaces/msg/ParameterDescriptor")(
+        msg: Any = get_message_class("rcl_interfaces/msg/ParameterDescriptor")(
             name=name,
             type=int(kind),
             description=self.description,
@@ -305,6 +310,8 @@ class ParameterStore:
         self._callbacks: list[Callback] = []
         self._on_event = on_event
         self._lock = threading.RLock()
+        # told when an on-set callback raises (the change then fails); None: the error propagates
+        self.on_callback_error: Callable[[Exception], None] | None = None
 
     # --- declaration -------------------------------------------------------------------------
 
@@ -370,6 +377,17 @@ class ParameterStore:
     def names(self) -> list[str]:
         """Declared parameter names, sorted."""
         return sorted(self._values)
+
+    def holding(self, value: object) -> list[str]:
+        """Names of the number parameters whose value is ``value`` (NaN matches NaN), sorted."""
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            return []
+        return [
+            name
+            for name, param in sorted(self._values.items())
+            if param.type_ in (ParameterType.DOUBLE, ParameterType.INTEGER)
+            and (param.value == value or (value != value and param.value != param.value))
+        ]
 
     def descriptor(self, name: str) -> Descriptor:
         """The descriptor of a declared parameter."""
@@ -443,13 +461,21 @@ class ParameterStore:
 
     def _run_callbacks(self, params: list[Parameter]) -> SetResult | None:
         for callback in list(self._callbacks):
-            result = callback(params)
+            try:
+                result = callback(params)
+            except Exception as err:  # the node's own bug: refuse the change, keep running
+                if self.on_callback_error is None:
+                    raise
+                self.on_callback_error(err)
+                return SetResult(False, f"{type(err).__name__}: {err}")
             if result is not None and not getattr(result, "successful", True):
                 return SetResult(False, str(getattr(result, "reason", "")))
         return None
 
     def _commit(self, params: list[Parameter]) -> None:
-        new, changed, deleted = [], [], []
+        new: list[Parameter] = []
+        changed: list[Parameter] = []
+        deleted: list[Parameter] = []
         for param in params:
             if param.type_ is ParameterType.NOT_SET:
                 if param.name in self._values:

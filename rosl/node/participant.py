@@ -12,8 +12,9 @@ import contextlib
 import itertools
 import os
 import select
+import socket
 import threading
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Protocol, cast
 
 from rosl.bus.header import Flags, topic_hash
 from rosl.bus.multicast import addressing_from_env
@@ -22,7 +23,6 @@ from rosl.bus.wire import Delivery, Reader, Writer
 from rosl.graph.announce import Discovery
 
 if TYPE_CHECKING:
-    import socket
     from collections.abc import Callable
 
     from rosl.bus.coalesce import Flusher
@@ -110,9 +110,10 @@ class Participant:
                 publishers.remove(publisher)
 
     def _on_replay_request(self, message: dict[str, object]) -> None:
-        # runs on the discovery thread: a late transient-local subscription asks for history
+        # runs on the discovery thread: a late transient-local subscription asks for history;
+        # its target is [hex sender, endpoint]
         topic = str(message["topic"])
-        sender, endpoint = message["target"]  # type: ignore[misc]
+        sender, endpoint = cast("tuple[str, int]", message["target"])
         target = (int(str(sender), 16), int(endpoint))
         with self._lock:
             publishers = list(self._replayers.get(topic, ()))
@@ -194,7 +195,8 @@ class Participant:
         if pending:
             timeout = 0.0
         try:
-            ready, _, _ = select.select([*sockets, self._wake_read], [], [], timeout)
+            watched: list[socket.socket | int] = [*sockets, self._wake_read]
+            ready, _, _ = select.select(watched, [], [], timeout)
         except (OSError, ValueError):
             return 0  # a socket closed under us (shutdown)
         if self._wake_read in ready:
@@ -206,7 +208,7 @@ class Participant:
         deliveries = pending
         drained = 0
         for sock in ready:
-            if sock is not self._wake_read:
+            if isinstance(sock, socket.socket):  # not the wake-up pipe
                 drained += 1
                 while self.reader.drain(sock, deliveries):
                     pass

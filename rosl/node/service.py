@@ -1,21 +1,46 @@
-"""Service servers: requests in, the callback's response out, addressed to the caller."""
+"""Service servers: requests in, the callback's response out, addressed to the caller.
+
+When the callback raises, the caller gets a ``Kind.FAILURE`` answer instead (JSON: the
+exception's type and message), so it fails at once rather than waiting out its timeout; the
+exception is logged with the node's name and the server keeps serving. Observers of service
+traffic (recorders, ``service echo``) see only requests and responses.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import json
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.bus.wire import Writer
+from rosl.errors import RoslError
 from rosl.graph.records import SERVER, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
 
 if TYPE_CHECKING:
+    import mmap
     from collections.abc import Callable
 
     from rosl.bus.wire import Delivery
     from rosl.idl.messages import ServiceType
     from rosl.node.node import Node
+
+
+def failure_payload(err: BaseException) -> bytes:
+    """A FAILURE answer's payload: the exception's type and message as JSON."""
+    return json.dumps({"type": type(err).__name__, "message": str(err)}).encode()
+
+
+def failure_text(payload: bytes | bytearray | memoryview | mmap.mmap) -> str:
+    """``ZeroDivisionError: division by zero`` from a FAILURE payload (whatever it holds)."""
+    try:
+        data = json.loads(bytes(payload))
+        kind, message = str(data["type"]), str(data["message"])
+    except (ValueError, TypeError, KeyError):
+        return bytes(payload).decode("utf-8", "replace") or "unknown error"
+    return f"{kind}: {message}" if message else kind
 
 
 class Service:
@@ -66,14 +91,24 @@ class Service:
         self.node.run_callback(lambda: self._answer(request, address), self.service_name)
 
     def _answer(self, request: Any, address: tuple[int, int, int]) -> None:
-        response = self.callback(request, self.srv_type.Response())
-        if getattr(response, "__msgtype__", None) != self.srv_type.Response.__msgtype__:
-            raise TypeError(
-                f"service {self.service_name} callback must return a "
-                f"{self.srv_type.Response.__msgtype__}, got {type(response).__name__}"
-            )
-        self._writer.send(self._store.serialize(response), address=address)
+        try:
+            response = self.callback(request, self.srv_type.Response())
+            if getattr(response, "__msgtype__", None) != self.srv_type.Response.__msgtype__:
+                raise TypeError(
+                    f"service {self.service_name} callback must return a "
+                    f"{self.srv_type.Response.__msgtype__}, got {type(response).__name__}"
+                )
+            payload = self._store.serialize(response)
+        except Exception as err:
+            self._fail(err, address)
+            raise  # logged with the node's name by run_callback; the server keeps serving
+        self._writer.send(payload, address=address)
         self.handled += 1
+
+    def _fail(self, err: Exception, address: tuple[int, int, int]) -> None:
+        """Tell the caller at once that this request failed, so it need not wait it out."""
+        with contextlib.suppress(RoslError):  # the callback's error is the one worth logging
+            self._writer.send(failure_payload(err), kind=Kind.FAILURE, address=address)
 
     def record(self) -> EndpointRecord:
         """This server as discovery announces it."""

@@ -118,10 +118,10 @@ class Subscription:
             address = delivery.address
             if address is None or address[0] != self._sender or address[1] != self.endpoint:
                 return
-            key = (delivery.sender, delivery.endpoint, delivery.seq)
-            if key in self._replayed:
+            replayed = (delivery.sender, delivery.endpoint, delivery.seq)
+            if replayed in self._replayed:
                 return
-            self._replayed.append(key)
+            self._replayed.append(replayed)
         elif delivery.kind != _DATA:
             return
         if delivery.type != self._type_hash:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 from rosl.node.clock import NS, Duration
+from rosl.node.errors import TimerPeriodError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -12,15 +14,53 @@ if TYPE_CHECKING:
     from rosl.node.clock import Clock
 
 
+MAX_PERIOD_NS = 2**63 - 1  # rcl keeps a timer's period in int64 nanoseconds
+
+
+def seconds_to_period_ns(seconds: float, what: str = "create_timer: timer_period_sec") -> int:
+    """Return ``seconds`` as a timer period in integer nanoseconds.
+
+    Raises:
+        TimerPeriodError: not a finite number > 0, or too long for int64 nanoseconds.
+    """
+    try:
+        value = float(seconds)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not math.isfinite(value) or value <= 0:
+        raise TimerPeriodError(f"{what} must be a finite number > 0, got {seconds!r}")
+    if value * NS > MAX_PERIOD_NS:
+        raise TimerPeriodError(
+            f"{what} must be at most {MAX_PERIOD_NS // NS} s (int64 nanoseconds), got {seconds!r}"
+        )
+    return max(1, round(value * NS))
+
+
+def _checked_ns(nanoseconds: int) -> int:
+    if (
+        isinstance(nanoseconds, float) and not math.isfinite(nanoseconds)
+    ) or not 0 < nanoseconds <= MAX_PERIOD_NS:
+        raise TimerPeriodError(
+            f"timer_period_ns must be an integer > 0 and at most {MAX_PERIOD_NS}, "
+            f"got {nanoseconds!r}"
+        )
+    return int(nanoseconds)
+
+
 class Timer:
     """Calls ``callback`` every ``timer_period_ns`` on ``clock`` (rclpy.timer.Timer)."""
 
-    def __init__(self, callback: Callable[[], Any] | None, period_ns: int, clock: Clock) -> None:
-        if period_ns <= 0:
-            raise ValueError("a timer period must be greater than 0")
+    def __init__(
+        self,
+        callback: Callable[[], Any] | None,
+        period_ns: int,
+        clock: Clock,
+        wake: Callable[[], None] | None = None,
+    ) -> None:
         self.callback = callback
         self.clock = clock
-        self._period_ns = int(period_ns)
+        self._wake = wake  # tells the spinning executor that the schedule changed
+        self._period_ns = _checked_ns(period_ns)
         self._canceled = False
         self._last_call_ns = clock.now_ns()
         self._next_call_ns = self._last_call_ns + self._period_ns
@@ -28,29 +68,45 @@ class Timer:
 
     @property
     def timer_period_ns(self) -> int:
-        """The period; setting it reschedules the next call from the last one."""
+        """The period; setting it starts the new period at once.
+
+        The next call comes one new period after the change, and the calls after it one new
+        period apart. rcl only swaps the period and keeps the call already scheduled (up to
+        one old period away); rescheduling from the last call instead made a call due at once,
+        or a few milliseconds before the next one. Neither is what a user changing a rate
+        expects.
+        """
         return self._period_ns
 
     @timer_period_ns.setter
     def timer_period_ns(self, period_ns: int) -> None:
-        if period_ns <= 0:
-            raise ValueError("a timer period must be greater than 0")
-        self._period_ns = int(period_ns)
-        self._next_call_ns = self._last_call_ns + self._period_ns
+        self._period_ns = _checked_ns(period_ns)
+        self._next_call_ns = self.clock.now_ns() + self._period_ns
+        self._rescheduled()
 
     def change_period(self, period_sec: float) -> None:
-        """Set the period in seconds."""
-        self.timer_period_ns = round(period_sec * NS)
+        """Set the period in seconds.
+
+        Raises:
+            TimerPeriodError: not a finite number of seconds > 0.
+        """
+        self.timer_period_ns = seconds_to_period_ns(period_sec, "change_period: period_sec")
 
     def cancel(self) -> None:
         """Stop calling back until :meth:`reset`."""
         self._canceled = True
 
     def reset(self) -> None:
-        """Restart: the next call is one period from now."""
+        """Restart: the next call is one period from now (the last call's time is kept)."""
+        now = self.clock.now_ns()
         self._canceled = False
-        self._last_call_ns = self.clock.now_ns()
-        self._next_call_ns = self._last_call_ns + self._period_ns
+        self._next_call_ns = now + self._period_ns
+        self._last_call_ns = min(self._last_call_ns, now)  # the clock went back (sim time on)
+        self._rescheduled()
+
+    def _rescheduled(self) -> None:
+        if self._wake is not None:  # an executor asleep until the old due time wakes up
+            self._wake()
 
     def is_canceled(self) -> bool:
         """Whether the timer is canceled."""

@@ -7,3 +7,7 @@ from rosl.errors import RoslError
 
 class PackageError(RoslError):
     """A package or executable that cannot be found or used."""
+
+
+class ExecutableError(PackageError):
+    """An executable whose declaration points at no module or function (``file:line: ...``)."""

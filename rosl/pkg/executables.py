@@ -42,18 +42,15 @@ def find_executable(package: str, name: str) -> Executable:
     )
 
 
+# ``-P``: the current folder stays off sys.path, so a ``rosl/`` folder there (a clone of rosl,
+# say) cannot shadow the installed package; the executable's own folders are added by the entry.
+_ENTRY = (sys.executable, "-P", "-m", "rosl.pkg.entry")
+
+
 def command_line(executable: Executable, args: list[str]) -> list[str]:
     """Return the argv that runs ``executable`` with ``args`` in a new process."""
     if executable.is_module:
-        return [
-            sys.executable,
-            "-m",
-            "rosl.pkg.entry",
-            str(executable.package_path),
-            executable.entry,
-            executable.name,
-            *args,
-        ]
+        return [*_ENTRY, str(executable.package_path), executable.entry, executable.name, *args]
     path = executable.path
     if not path.is_file():
         raise PackageError(
@@ -61,13 +58,5 @@ def command_line(executable: Executable, args: list[str]) -> list[str]:
             f"{path}, which does not exist"
         )
     if path.suffix == ".py" or not os.access(path, os.X_OK):
-        return [
-            sys.executable,
-            "-m",
-            "rosl.pkg.entry",
-            str(executable.package_path),
-            str(path),
-            executable.name,
-            *args,
-        ]
+        return [*_ENTRY, str(executable.package_path), str(path), executable.name, *args]
     return [str(path), *args]

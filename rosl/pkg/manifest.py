@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import ast
 import configparser
+import contextlib
 import xml.etree.ElementTree as ET
+import xml.parsers.expat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -154,6 +156,36 @@ def _setup_console_scripts(location: search_path.PackageLocation) -> tuple[Execu
                 Executable(location.name, name.strip(), entry.strip(), location.path)
             )
     return tuple(executables)
+
+
+def declaration_site(package_path: Path, name: str, entry: str) -> str:
+    """Return ``file:line`` where executable ``name`` is declared (``file`` if no line is known).
+
+    package.xml's ``<executable name="...">`` comes first, then a ``console_scripts`` line of
+    setup.py or setup.cfg that holds ``entry``.
+    """
+    manifest = package_path / search_path.MANIFEST
+    lines: dict[str, int] = {}
+    parser = xml.parsers.expat.ParserCreate()
+
+    def start(tag: str, attributes: dict[str, str]) -> None:
+        if tag == "executable" and "name" in attributes:
+            lines.setdefault(attributes["name"].strip(), parser.CurrentLineNumber)
+
+    parser.StartElementHandler = start
+    with contextlib.suppress(OSError, xml.parsers.expat.ExpatError):
+        parser.Parse(manifest.read_bytes(), True)
+    if name in lines:
+        return f"{manifest}:{lines[name]}"
+    for setup in (package_path / "setup.py", package_path / "setup.cfg"):
+        try:
+            text = setup.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            continue
+        for number, line in enumerate(text.splitlines(), start=1):
+            if entry in line and name in line:
+                return f"{setup}:{number}"
+    return str(manifest)
 
 
 def get_package(name: str) -> Package:

@@ -55,7 +55,7 @@ class _Layout:
 
 
 def _split_secs(now_ns: int) -> tuple[int, int]:
-    return divmod(now_ns, NS)  # type: ignore[return-value]
+    return divmod(now_ns, NS)
 
 
 _CLOCK = struct.Struct("<4siI")

@@ -319,7 +319,7 @@ def wheel_transforms(sim_robot: SimRobot) -> list[Transform]:
     """The wheel links turned by their joints for :func:`tf_bytes` (same as :func:`wheel_tf`)."""
     model = sim_robot.robot.spec.model
     angles = dict(zip(model.joints, sim_robot.robot.wheels, strict=False))
-    transforms = []
+    transforms: list[Transform] = []
     for frame in model.frames:
         if frame.joint is None:
             continue

@@ -3,6 +3,7 @@
 SVG is written by hand (a few element types; no library needed). PNG is drawn with Pillow at
 three times the size and scaled down, which smooths the lines. A :class:`Scene` is plain data
 in one fixed frame (metres); the simulator and ``rosl viz`` (live or from a bag) both fill one.
+Frame labels are placed by :func:`place_labels`, so frames at one spot stay readable.
 """
 
 from __future__ import annotations
@@ -18,7 +19,10 @@ if TYPE_CHECKING:
     from rosl.sim.simulation import Simulation
 
 Point = tuple[float, float]
+Box = tuple[float, float, float, float]  # left, top, right, bottom, in pixels (y down)
 PATH_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e")
+LABEL_OFFSET = 4.0  # pixels between a frame's origin and its label
+LABEL_GAP = 2.0  # pixels kept free between two labels
 
 
 @dataclass(slots=True)
@@ -89,6 +93,50 @@ class _View:
         )
 
 
+def _overlaps(a: Box, b: Box, gap: float) -> bool:
+    return a[0] < b[2] + gap and b[0] < a[2] + gap and a[1] < b[3] + gap and b[1] < a[3] + gap
+
+
+def place_labels(
+    anchors: list[Point],
+    sizes: list[tuple[float, float]],
+    offset: float = LABEL_OFFSET,
+    gap: float = LABEL_GAP,
+) -> list[Box]:
+    """Boxes for labels beside their anchors (pixels, y down), no two of them overlapping.
+
+    Each label, in order, takes the first free place of: below-right, above-right, below-left,
+    above-left of its anchor. When all four touch a label placed before, it goes below-right,
+    moved down under each label it would touch until it touches none.
+
+    Args:
+        anchors: the points the labels belong to.
+        sizes: each label's (width, height).
+        offset: the distance from the anchor to a label, on both axes.
+        gap: the space kept free between two labels.
+
+    Returns:
+        One (left, top, right, bottom) box per label, in the order given.
+    """
+    placed: list[Box] = []
+    for (x, y), (width, height) in zip(anchors, sizes, strict=True):
+        corners = [
+            (x + offset, y + offset),
+            (x + offset, y - offset - height),
+            (x - offset - width, y + offset),
+            (x - offset - width, y - offset - height),
+        ]
+        boxes = [(left, top, left + width, top + height) for left, top in corners]
+        box = next((b for b in boxes if not any(_overlaps(b, p, gap) for p in placed)), None)
+        if box is None:
+            box = boxes[0]
+            while (hit := next((p for p in placed if _overlaps(box, p, gap)), None)) is not None:
+                top = hit[3] + gap + 1e-6  # strictly below the label it touched
+                box = (box[0], top, box[2], top + height)
+        placed.append(box)
+    return placed
+
+
 def _axes(origin: Point, yaw: float, length: float) -> tuple[Point, Point]:
     x, y = origin
     return (
@@ -140,8 +188,11 @@ def svg(scene: Scene, width: int = 900) -> str:
             'stroke="#333333"/>'
         )
     length = 30 / view.scale
-    for name, origin, yaw in scene.frames:
-        (ox, oy) = view(origin)
+    origins = [view(origin) for _, origin, _ in scene.frames]
+    # sans-serif at 11 px: about 0.62 em per character, 13 px from top to bottom
+    sizes = [(0.62 * 11 * len(name), 13.0) for name, _, _ in scene.frames]
+    labels = place_labels(origins, sizes)
+    for (name, origin, yaw), (ox, oy), box in zip(scene.frames, origins, labels, strict=True):
         tip_x, tip_y = (view(p) for p in _axes(origin, yaw, length))
         parts.append(
             f'<line x1="{ox:.1f}" y1="{oy:.1f}" x2="{tip_x[0]:.1f}" y2="{tip_x[1]:.1f}" '
@@ -151,8 +202,14 @@ def svg(scene: Scene, width: int = 900) -> str:
             f'<line x1="{ox:.1f}" y1="{oy:.1f}" x2="{tip_y[0]:.1f}" y2="{tip_y[1]:.1f}" '
             'stroke="green" stroke-width="2"/>'
         )
+        if _moved(box, (ox, oy), 13.0):
+            near = _nearest_corner(box, (ox, oy))
+            parts.append(
+                f'<line x1="{ox:.1f}" y1="{oy:.1f}" x2="{near[0]:.1f}" y2="{near[1]:.1f}" '
+                'stroke="#999999" stroke-width="1"/>'
+            )
         parts.append(
-            f'<text x="{ox + 4:.1f}" y="{oy + 14:.1f}" font-family="sans-serif" '
+            f'<text x="{box[0]:.1f}" y="{box[3] - 2:.1f}" font-family="sans-serif" '
             f'font-size="11">{escape(name)}</text>'
         )
     parts.append("</svg>")
@@ -186,12 +243,20 @@ def _png(scene: Scene, path: Path, width: int) -> None:
     for footprint in scene.footprints:
         draw.polygon([view(p) for p in footprint], fill="#ffd54f", outline="#333333")
     length = 30 * factor / view.scale
-    for name, origin, yaw in scene.frames:
-        o = view(origin)
+    origins = [view(origin) for _, origin, _ in scene.frames]
+    sizes = []
+    for name, _, _ in scene.frames:
+        left, top, right, bottom = draw.textbbox((0, 0), name, font_size=11 * factor)
+        sizes.append((right - left, bottom - top))
+    labels = place_labels(origins, sizes, LABEL_OFFSET * factor, LABEL_GAP * factor)
+    for (name, origin, yaw), o, box, size in zip(scene.frames, origins, labels, sizes, strict=True):
         tip_x, tip_y = (view(p) for p in _axes(origin, yaw, length))
         draw.line([o, tip_x], fill="red", width=2 * factor)
         draw.line([o, tip_y], fill="green", width=2 * factor)
-        draw.text((o[0] + 4 * factor, o[1] + 4 * factor), name, fill="black", font_size=11 * factor)
+        if _moved(box, o, size[1] + LABEL_OFFSET * factor):
+            draw.line([o, _nearest_corner(box, o)], fill="#999999", width=factor)
+        left, top, _, _ = draw.textbbox((0, 0), name, font_size=11 * factor)
+        draw.text((box[0] - left, box[1] - top), name, fill="black", font_size=11 * factor)
     draw.text(
         (8 * factor, 6 * factor),
         f"{scene.title} (fixed frame: {scene.frame})",
@@ -200,6 +265,18 @@ def _png(scene: Scene, path: Path, width: int) -> None:
     )
     image = image.resize((width, height // factor), Image.Resampling.LANCZOS)
     image.save(path)
+
+
+def _moved(box: Box, anchor: Point, reach: float) -> bool:
+    """Whether a label was pushed away from its anchor (then a thin line joins them)."""
+    dx = max(box[0] - anchor[0], anchor[0] - box[2], 0.0)
+    dy = max(box[1] - anchor[1], anchor[1] - box[3], 0.0)
+    return dx > reach or dy > reach
+
+
+def _nearest_corner(box: Box, anchor: Point) -> Point:
+    corners = [(box[0], box[1]), (box[2], box[1]), (box[0], box[3]), (box[2], box[3])]
+    return min(corners, key=lambda c: (c[0] - anchor[0]) ** 2 + (c[1] - anchor[1]) ** 2)
 
 
 def footprint_points(

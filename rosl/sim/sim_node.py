@@ -281,12 +281,13 @@ class SimNode:
         else:
             self.node.participant.poll(0.0)
         recorder = self.recorder
-        if recorder is not None and recorder.participant is not None:
+        participant = recorder.participant if recorder is not None else None
+        if recorder is not None and participant is not None:
             own = self._own_sent()
             expected = [*replies, *own]
             lockstep = self.lockstep
             check = (
-                (lambda: lockstep.caught_up(recorder.participant, expected))
+                (lambda: lockstep.caught_up(participant, expected))
                 if (lockstep is not None)
                 else None
             )

@@ -162,6 +162,7 @@ class Simulation:
         """
         assert isinstance(robot, pymunk.Poly)
         space, body = self.space.space, robot.body
+        assert body is not None  # a shape in a space has its body
         corners = [body.local_to_world(v) for v in robot.get_vertices()]
         best = math.inf
         for corner in corners:
@@ -200,6 +201,7 @@ def _circumscribed(footprint: Polygon) -> float:
 def _features(shape: pymunk.Shape) -> list[tuple[tuple[float, float], float]]:
     """An obstacle's corners (or centre, or ends) in the world, with its rounding radius."""
     body = shape.body
+    assert body is not None  # a shape in a space has its body
     if isinstance(shape, pymunk.Circle):
         return [(body.local_to_world(shape.offset), shape.radius)]
     if isinstance(shape, pymunk.Segment):

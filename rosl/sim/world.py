@@ -39,7 +39,7 @@ def _pymunk_shapes(body: pymunk.Body, shape: Shape) -> list[pymunk.Shape]:
         if signed_area(points) < 0:
             points.reverse()
         hulls = convex_decomposition([*points, points[0]], 0.0)
-        return [pymunk.Poly(body, [tuple(p) for p in hull[:-1]]) for hull in hulls]
+        return [pymunk.Poly(body, [(p.x, p.y) for p in hull[:-1]]) for hull in hulls]
     return [_pymunk_shape(body, shape)]
 
 

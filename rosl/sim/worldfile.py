@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rosl.sim.errors import WorldFileError
 from rosl.sim.model import (
@@ -29,6 +29,9 @@ from rosl.sim.model import (
 from rosl.sim.yaml_reader import LINE as _LINE
 from rosl.sim.yaml_reader import LINES as _LINES
 from rosl.sim.yaml_reader import YamlReader as _Reader
+
+if TYPE_CHECKING:
+    from collections.abc import Set as AbstractSet
 
 __all__ = [  # the records live in model.py; importing them from here keeps working
     "ROBOT_FORMAT",
@@ -83,7 +86,9 @@ def _ccw(points: list[Point]) -> list[Point]:
     return points if signed_area(points) > 0 else points[::-1]
 
 
-def _shapes(reader: _Reader, item: Any, line: int, extra: set[str] = frozenset()) -> list[Shape]:
+def _shapes(
+    reader: _Reader, item: Any, line: int, extra: AbstractSet[str] = frozenset()
+) -> list[Shape]:
     entry = reader.item(line, item, "a shape with 'type:'")
     if "type" not in entry:
         raise reader.fail(entry[_LINE], f"each shape needs 'type:' ({', '.join(_SHAPE_KEYS)})")
@@ -98,7 +103,7 @@ def _shapes(reader: _Reader, item: Any, line: int, extra: set[str] = frozenset()
     name = reader.text(entry, "name", kind)
     if kind == "cylinder":
         center = reader.point(entry, "center")
-        return [Circle(name, center, reader.number(entry, "radius", positive=True))]  # type: ignore[arg-type]
+        return [Circle(name, center, reader.number(entry, "radius", positive=True))]
     if kind == "box":
         size = reader.point(entry, "size")
         if min(size) <= 0:
@@ -107,7 +112,7 @@ def _shapes(reader: _Reader, item: Any, line: int, extra: set[str] = frozenset()
             )
         center = reader.point(entry, "center")
         yaw = reader.number(entry, "yaw", default=0.0)
-        return [Polygon(name, tuple(_box(center, size, yaw)))]  # type: ignore[arg-type]
+        return [Polygon(name, tuple(_box(center, size, yaw)))]
     if kind == "segment":
         a, b = reader.points(entry, "points", 2)[:2]
         return [Segment(name, a, b, reader.number(entry, "radius", default=0.01, positive=True))]
@@ -323,7 +328,7 @@ def _footprint(reader: _Reader, data: dict[str, Any]) -> Circle | Polygon:
                 reader.line_of(foot, "size"), f"'size' must be positive, not {list(size)}"
             )
         offset = reader.point(foot, "offset") if "offset" in foot else (0.0, 0.0)
-        return Polygon("footprint", tuple(_box(offset, size, 0.0)))  # type: ignore[arg-type]
+        return Polygon("footprint", tuple(_box(offset, size, 0.0)))
     raise reader.fail(foot[_LINE], "footprint type must be 'circle' or 'box'")
 
 
@@ -339,8 +344,8 @@ def _frames(reader: _Reader, data: dict[str, Any]) -> tuple[Frame, ...]:
             Frame(
                 str(name),
                 reader.text(frame, "parent"),
-                reader.point(frame, "xyz", 3),  # type: ignore[arg-type]
-                reader.point(frame, "rpy", 3) if "rpy" in frame else (0.0, 0.0, 0.0),  # type: ignore[arg-type]
+                reader.point(frame, "xyz", 3),
+                reader.point(frame, "rpy", 3) if "rpy" in frame else (0.0, 0.0, 0.0),
                 reader.text(frame, "joint") if "joint" in frame else None,
             )
         )
@@ -380,7 +385,7 @@ def _lidar(reader: _Reader, line: int, item: Any, frames: tuple[Frame, ...]) -> 
         range_min,
         range_max,
         reader.number(sensor, "noise_stddev", default=0.0, minimum=0.0),
-        xy,  # type: ignore[arg-type]
+        xy,
     )
 
 
@@ -446,7 +451,7 @@ def load_world(path: Path) -> World:
         pose = reader.point(entry, "pose", 3)
         namespace = reader.text(entry, "namespace", "").strip("/")
         name = reader.text(entry, "name", model.name)
-        robots.append(RobotSpec(name, model, pose, namespace))  # type: ignore[arg-type]
+        robots.append(RobotSpec(name, model, pose, namespace))
         entries.append(entry)
     world = World(
         str(data.get("name", path.stem)),

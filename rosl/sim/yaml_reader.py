@@ -7,13 +7,14 @@ item, so every complaint can say ``file:line: what is expected``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import yaml
 
 from rosl.sim.errors import WorldFileError
 
 if TYPE_CHECKING:
+    from collections.abc import Hashable
     from pathlib import Path
 
 LINES = "__lines__"
@@ -26,13 +27,13 @@ class Loader(yaml.SafeLoader):
     """Remembers the line of every mapping and of each of its keys, and of each list item."""
 
 
-class Items(list):  # type: ignore[type-arg]
+class Items(list[Any]):
     """A YAML list that remembers the line of each of its items."""
 
     lines: list[int]
 
 
-def _mapping(loader: Loader, node: yaml.MappingNode) -> dict[str, Any]:
+def _mapping(loader: Loader, node: yaml.MappingNode) -> dict[Hashable, Any]:
     mapping = loader.construct_mapping(node, deep=True)
     mapping[LINE] = node.start_mark.line + 1
     mapping[LINES] = {k.value: k.start_mark.line + 1 for k, _ in node.value}
@@ -177,6 +178,14 @@ class YamlReader:
             )
         return value
 
+    @overload
+    def point(
+        self, entry: dict[str, Any], key: str, size: Literal[2] = 2
+    ) -> tuple[float, float]: ...
+    @overload
+    def point(
+        self, entry: dict[str, Any], key: str, size: Literal[3]
+    ) -> tuple[float, float, float]: ...
     def point(self, entry: dict[str, Any], key: str, size: int = 2) -> tuple[float, ...]:
         """A list of ``size`` finite numbers: ``[x, y]`` or ``[x, y, yaw]``."""
         value = entry.get(key)

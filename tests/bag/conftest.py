@@ -40,7 +40,7 @@ pubs = {
     "/pose": node.create_publisher(PoseStamped, "/pose", 10),
 }
 for pub in pubs.values():
-    pub.wait_for_subscribers(1, 10.0)
+    pub.wait_for_subscribers(1, 30.0)
 time.sleep(0.3)
 
 def make(topic, value):
@@ -143,13 +143,13 @@ def scenario_bag(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
                 cwd=folder, start_new_session=True,
             )  # fmt: skip
             children.append(recorder)
-            assert _wait_for_text(log, "Recording to", 15.0), log.read_text()
+            assert _wait_for_text(log, "Recording to", 30.0), log.read_text()
             scenario = subprocess.Popen(
                 [sys.executable, "-c", SCENARIO], env=env, cwd=folder, start_new_session=True,
                 stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
             )  # fmt: skip
             children.append(scenario)
-            assert scenario.wait(timeout=30) == 0, log.read_text()
+            assert scenario.wait(timeout=60) == 0, log.read_text()
             _end(recorder)
         counts = {t: sum(1 for m in mcap_messages(bag) if m.topic == t) for t in TYPES}
         assert counts == {"/chatter": 5, "/numbers": 3, "/pose": 3}, log.read_text()
@@ -182,7 +182,7 @@ class Listener:
 
         return heard
 
-    def spin_until(self, done: Callable[[], bool], timeout: float = 15.0) -> bool:
+    def spin_until(self, done: Callable[[], bool], timeout: float = 30.0) -> bool:
         """Spin until ``done()`` or the (bounded) timeout."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -191,7 +191,7 @@ class Listener:
             self.rosl.spin_once(self.node, timeout_sec=0.02)
         return done()
 
-    def spin_while_running(self, child: subprocess.Popen[str], timeout: float = 15.0) -> None:
+    def spin_while_running(self, child: subprocess.Popen[str], timeout: float = 30.0) -> None:
         """Spin while ``child`` runs, then a little longer for the last datagrams."""
         self.spin_until(lambda: child.poll() is not None, timeout)
         end = time.monotonic() + 0.2

@@ -28,7 +28,7 @@ rosl.init([])
 node = rosl.create_node("talker")
 String = get_message_class("std_msgs/msg/String")
 publisher = node.create_publisher(String, "/chatter", 10)
-publisher.wait_for_subscribers(1, 10.0)
+publisher.wait_for_subscribers(1, 30.0)
 time.sleep(0.2)
 for index in range(3):
     publisher.publish(String(data=f"{sys.argv[1]} {index}"))

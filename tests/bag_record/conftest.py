@@ -82,8 +82,8 @@ from example_interfaces.srv import AddTwoInts
 rosl.init([])
 node = rosl.Node("adder_client")
 client = node.create_client(AddTwoInts, "/add_two_ints")
-assert client.wait_for_service(timeout_sec=15.0), "no server"
-deadline = time.monotonic() + 15.0
+assert client.wait_for_service(timeout_sec=30.0), "no server"
+deadline = time.monotonic() + 30.0
 while node.count_subscribers("/add_two_ints/_service_event") < 1:
     assert time.monotonic() < deadline, "the recorder never subscribed to the service events"
     time.sleep(0.02)
@@ -126,7 +126,7 @@ def service_bag(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceBag
         )
         other = support.start_recorder(group, "-a", "-o", str(plain), cwd=root)
         server = support.Child(group.python(SERVER, cwd=root))
-        assert server.wait_for("^READY", timeout=20), server.both()
+        assert server.wait_for("^READY", timeout=30), server.both()
         support.run_publisher(
             group,
             {"node": "info_talker", "wait_subscribers": 2,
@@ -137,7 +137,7 @@ def service_bag(tmp_path_factory: pytest.TempPathFactory) -> Iterator[ServiceBag
             cwd=root,
         )  # fmt: skip
         client = support.Child(group.python(CLIENT, json.dumps(CALLS), cwd=root))
-        assert client.finish(30) == 0, client.both()
+        assert client.finish(60) == 0, client.both()
         calls = [json.loads(line) for line in client.lines() if line.startswith("{")]
         server.signal(signal.SIGINT, timeout=10)
         support.stop_recorder(recorder)

@@ -47,7 +47,7 @@ class Child(ChildOutput):
         self.pump()
         return self.text[stream].splitlines()
 
-    def wait_for(self, pattern: str, *, stream: str = "out", timeout: float = 10.0) -> bool:
+    def wait_for(self, pattern: str, *, stream: str = "out", timeout: float = 30.0) -> bool:
         """Whether a line matching ``pattern`` appears within ``timeout``."""
         regex = re.compile(pattern, re.MULTILINE)
         deadline = time.monotonic() + timeout
@@ -65,7 +65,7 @@ class Child(ChildOutput):
         return len(re.findall(pattern, self.text[stream], re.MULTILINE))
 
     def wait_count(
-        self, pattern: str, count: int, *, stream: str = "out", timeout: float = 10.0
+        self, pattern: str, count: int, *, stream: str = "out", timeout: float = 30.0
     ) -> bool:
         deadline = time.monotonic() + timeout
         while self.count(pattern, stream) < count:
@@ -96,7 +96,7 @@ class Child(ChildOutput):
 
 
 def start_recorder(
-    processes: Processes, *args: str, cwd: Path | None = None, timeout: float = 20.0
+    processes: Processes, *args: str, cwd: Path | None = None, timeout: float = 30.0
 ) -> Child:
     """``rosl bag record ARGS`` as a child, returned once it prints "Recording to"."""
     child = Child(processes.rosl("bag", "record", *args, cwd=cwd))
@@ -153,7 +153,7 @@ for entry in spec["publishers"]:
         reliability=ReliabilityPolicy[words.get("reliability", "RELIABLE")],
     )
     publishers.append(node.create_publisher(registry.get_message_class(entry["type"]), entry["topic"], qos))
-deadline = time.monotonic() + spec.get("wait_timeout", 15.0)
+deadline = time.monotonic() + spec.get("wait_timeout", 30.0)
 for entry, publisher in zip(spec["publishers"], publishers):
     wanted = entry.get("wait", spec.get("wait_subscribers", 1))
     while publisher.get_subscription_count() < wanted and time.monotonic() < deadline:

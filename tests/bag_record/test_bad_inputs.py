@@ -269,7 +269,7 @@ def test_recording_onto_a_full_disk_stops_with_one_line_and_claims_no_success(
     recorder = support.Child(
         processes.python(FULL_DISK, "bag", "record", "-a", "-o", str(folder), cwd=tmp_path)
     )
-    assert recorder.wait_for(support.RECORDING_TO, stream="err", timeout=20), recorder.both()
+    assert recorder.wait_for(support.RECORDING_TO, stream="err", timeout=30), recorder.both()
     blobs = [(0, {"data": f"{i:04d}" + "x" * 2000}) for i in range(1, 151)]
     publisher = support.start_publisher(
         processes,

@@ -2,9 +2,10 @@
 folder; SIGINT and SIGTERM finish a complete, indexed file with its metadata.yaml.
 
 A publisher sends Int32 1..N at 50 Hz and prints the wall-clock time around each publish; the
-recorders are signalled while it is publishing. Every message published more than 1.2 s
-before a SIGKILL must be in the repaired bag, and what is there must be exactly a prefix
-1..K of what was sent.
+recorders are signalled while it is publishing. The recorder flushes every second, so every
+message published more than 3 s before a SIGKILL (the flush period, and slack for a loaded
+machine) must be in the repaired bag, and what is there must be exactly a prefix 1..K of what
+was sent.
 """
 
 from __future__ import annotations
@@ -61,15 +62,15 @@ class Killed:
 def killed(module_bus: DomainProcesses, module_dir: Path) -> Killed:
     folder = module_dir / "killed"
     recorder = support.start_recorder(module_bus, "-a", "-o", str(folder), cwd=module_dir)
-    publisher = support.start_publisher(module_bus, counter_spec(200, "crash_talker"), module_dir)
-    # let it publish for about 2.5 s, then kill the recorder while messages keep coming
-    assert publisher.wait_count(r'^\{"i": ', 125, timeout=30), publisher.both()
+    publisher = support.start_publisher(module_bus, counter_spec(300, "crash_talker"), module_dir)
+    # let it publish for about 5 s, then kill the recorder while messages keep coming
+    assert publisher.wait_count(r'^\{"i": ', 250, timeout=60), publisher.both()
     kill_ns = time.time_ns()
     recorder.popen.send_signal(signal.SIGKILL)
     assert recorder.finish(10) == -signal.SIGKILL
     assert publisher.finish(30) == 0, publisher.both()
     times = support.sent_times(publisher)
-    assert len(times) == 200
+    assert len(times) == 300
     raw = module_dir / "killed_raw"
     shutil.copytree(folder, raw)
     reindex = support.rosl_run("bag", "reindex", str(folder))
@@ -97,7 +98,7 @@ def test_the_unfinished_file_already_holds_flushed_messages(killed: Killed) -> N
                 found += type(record).__name__ == "Message"
         except Exception:  # the torn tail of the file
             pass
-    assert found > 0, "nothing was flushed to disk in 2.5 s of recording"
+    assert found > 0, "nothing was flushed to disk in 5 s of recording"
 
 
 def test_bag_info_on_a_killed_recording_says_it_is_unfinished_and_suggests_reindex(
@@ -169,13 +170,15 @@ def test_the_recovered_counter_is_exactly_a_prefix_of_what_was_published(
         assert killed.times[value - 1]["before"] < killed.kill_ns, value
 
 
-def test_every_message_published_over_1_2_s_before_the_kill_survived(killed: Killed) -> None:
+def test_every_message_published_over_3_s_before_the_kill_survived(killed: Killed) -> None:
     values = [
         m.fields["data"]
         for m in support.by_topic(support.read_anyreader(killed.folder))["/counter"]
     ]
+    # flushed once a second: 3 s leaves room for a recorder slowed down by a loaded machine,
+    # while a recorder that only wrote at its end would keep nothing
     must = [
-        i + 1 for i, t in enumerate(killed.times) if t["after"] < killed.kill_ns - 1_200_000_000
+        i + 1 for i, t in enumerate(killed.times) if t["after"] < killed.kill_ns - 3_000_000_000
     ]
     assert must, "the kill came too early to test the bound"
     assert len(values) >= must[-1], (len(values), must[-1])
@@ -219,7 +222,7 @@ def stopped(module_bus: DomainProcesses, module_dir: Path) -> dict[str, Stopped]
     )
     found = {}
     for name, after in (("SIGTERM", 80), ("SIGINT", 110)):
-        assert publisher.wait_count(r'^\{"i": ', after, timeout=30), publisher.both()
+        assert publisher.wait_count(r'^\{"i": ', after, timeout=60), publisher.both()
         signal_ns = time.time_ns()
         stderr = support.stop_recorder(recorders[name], getattr(signal, name))
         found[name] = Stopped(folders[name], signal_ns, stderr)

@@ -12,7 +12,10 @@ from rosl.idl.idl_text import full_idl
 from tests.bag_record import support
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from tests.bag_record.conftest import ServiceBag
+    from tests.conftest import Processes
 
 EVENT_TOPIC = "/add_two_ints/_service_event"
 EVENT_TYPE = "example_interfaces/srv/AddTwoInts_Event"
@@ -117,3 +120,73 @@ def test_without_include_services_no_service_events_are_recorded(
     counts = support.topic_counts(service_bag.plain)
     assert counts["/numbers"] == 5
     assert not [t for t in counts if t.endswith("/_service_event")], counts
+
+
+FAILING_SERVER = r"""
+import rosl
+from example_interfaces.srv import AddTwoInts
+
+rosl.init([])
+node = rosl.Node("picky_adder")
+
+
+def add(request, response):
+    if request.a < 0:
+        raise ValueError("no negative numbers")
+    response.sum = request.a + request.b
+    return response
+
+
+node.create_service(AddTwoInts, "/add_two_ints", add)
+print("READY", flush=True)
+rosl.spin(node)
+"""
+
+FAILING_CLIENT = r"""
+import time
+import rosl
+from example_interfaces.srv import AddTwoInts
+from rosl.node.client import ServiceFailedError
+
+rosl.init([])
+node = rosl.Node("picky_client")
+client = node.create_client(AddTwoInts, "/add_two_ints")
+assert client.wait_for_service(timeout_sec=30.0), "no server"
+deadline = time.monotonic() + 30.0
+while node.count_subscribers("/add_two_ints/_service_event") < 1:
+    assert time.monotonic() < deadline, "the recorder never subscribed to the service events"
+    time.sleep(0.02)
+time.sleep(0.2)
+try:
+    client.call(AddTwoInts.Request(a=-1, b=1), timeout_sec=20.0)
+except ServiceFailedError as err:
+    print("failed", err, flush=True)
+print("sum", client.call(AddTwoInts.Request(a=2, b=3), timeout_sec=20.0).sum, flush=True)
+rosl.shutdown()
+"""
+
+
+def test_a_failed_call_records_its_request_and_the_recording_goes_on(
+    processes: Processes, tmp_path: Path
+) -> None:
+    folder = tmp_path / "failed_call"
+    recorder = support.start_recorder(
+        processes, "-a", "--include-services", "-o", str(folder), cwd=tmp_path
+    )
+    server = support.Child(processes.python(FAILING_SERVER, cwd=tmp_path))
+    assert server.wait_for("^READY", timeout=30), server.both()
+    client = support.Child(processes.python(FAILING_CLIENT, cwd=tmp_path))
+    assert client.finish(60) == 0, client.both()
+    assert client.lines() == [
+        "failed service /add_two_ints failed: ValueError: no negative numbers",
+        "sum 5",
+    ], client.both()
+    err = support.stop_recorder(recorder)
+    assert "Traceback" not in err, err
+    assert "WARN" not in err, err
+    found = [m.fields for m in support.by_topic(support.read_anyreader(folder))[EVENT_TOPIC]]
+    assert [(e["info"]["event_type"], e["request"], e["response"]) for e in found] == [
+        (REQUEST_SENT, [{"a": -1, "b": 1}], []),
+        (REQUEST_SENT, [{"a": 2, "b": 3}], []),
+        (RESPONSE_SENT, [], [{"sum": 5}]),
+    ]

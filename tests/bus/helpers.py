@@ -211,7 +211,7 @@ rosl.init()
 node = rosl.Node("bus_probe")
 graph = node.participant.graph
 want = set(sys.argv[1:])
-found = graph.wait_for(lambda: want <= {n.fqn for n in graph.nodes()}, 5.0)
+found = graph.wait_for(lambda: want <= {n.fqn for n in graph.nodes()}, 15.0)
 print("nodes", " ".join(sorted(n.fqn for n in graph.nodes())), flush=True)
 print("found" if found else "missing", flush=True)
 rosl.shutdown()

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from rosl.bus.coalesce import RECORD, Flusher
-from rosl.bus.header import HEADER, MAGIC, VERSION, Flags, Kind, topic_hash
+from rosl.bus.coalesce import RECORD, Flusher, split_records
+from rosl.bus.header import HEADER, HEADER_SIZE, MAGIC, VERSION, Flags, Kind, topic_hash
 from rosl.bus.multicast import Addressing
 from rosl.bus.transport import MulticastTransport
 from tests.bus.test_wire import ENDPOINT, SENDER, TOPIC, Bus, payload_of
@@ -18,11 +18,16 @@ if TYPE_CHECKING:
     import socket
     from collections.abc import Iterator
 
+    from rosl.bus.wire import Delivery
+
+
+LIMIT = 16384  # the batch bound the tests give the writer
+
 
 class Counted:
     """A bus whose writer coalesces, plus a second socket on the channel counting datagrams."""
 
-    def __init__(self, domain: int, delay_s: float = 0.001, limit: int = 16384) -> None:
+    def __init__(self, domain: int, delay_s: float = 0.001, limit: int = LIMIT) -> None:
         self.bus = Bus(domain)
         self.flusher = Flusher(delay_s)
         self.bus.writer.coalesce(self.flusher, limit)
@@ -51,35 +56,77 @@ def counted(domain_id: int) -> Iterator[Counted]:
         c.close()
 
 
-def test_small_messages_share_datagrams_and_arrive_whole_in_order(counted: Counted) -> None:
-    payloads = [payload_of(64, seed=n) for n in range(1000)]
-    stamps = []
-    for n, payload in enumerate(payloads):
-        stamps.append(1_000_000 + n)
-        counted.bus.writer.send(payload, stamp=stamps[-1])
+def batched_records(datagrams: list[bytes]) -> list[list[tuple[int, int, bytes]]]:
+    """The (seq, stamp, bytes) records of each datagram, checking each is a well-formed batch."""
+    out = []
+    for datagram in datagrams:
+        assert datagram[:2] == MAGIC
+        assert HEADER.unpack_from(datagram)[3] & Flags.BATCH
+        records = split_records(memoryview(datagram)[HEADER_SIZE:])
+        out.append([(seq, stamp, bytes(body)) for seq, stamp, body in records])
+    return out
 
-    got = counted.bus.collector.wait_count(1000)
+
+def send_thousand(counted: Counted) -> tuple[list[bytes], list[int]]:
+    """Send 1000 small messages with explicit stamps; return the payloads and stamps."""
+    payloads = [payload_of(64, seed=n) for n in range(1000)]
+    stamps = [1_000_000 + n for n in range(1000)]
+    for payload, stamp in zip(payloads, stamps, strict=True):
+        counted.bus.writer.send(payload, stamp=stamp)
+    return payloads, stamps
+
+
+def assert_whole_and_in_order(
+    got: list[Delivery], payloads: list[bytes], stamps: list[int]
+) -> None:
     assert [bytes(d.payload) for d in got] == payloads
-    assert [d.seq for d in got] == list(range(1, 1001))
+    assert [d.seq for d in got] == list(range(1, len(payloads) + 1))
     assert [d.stamp for d in got] == stamps
     assert {(d.kind, d.sender, d.endpoint, d.flags) for d in got} == {
         (Kind.DATA, SENDER, ENDPOINT, 0)
     }
+
+
+def test_small_messages_share_datagrams_and_arrive_whole_in_order(counted: Counted) -> None:
+    # What holds however the flusher thread is scheduled: every message arrives once, whole
+    # and in order, in batch datagrams that keep the size bound and carry the records in order.
+    payloads, stamps = send_thousand(counted)
+    got = counted.bus.collector.wait_count(1000, timeout=20.0)
+    assert_whole_and_in_order(got, payloads, stamps)
     assert counted.bus.reader.lost() == 0
-    datagrams = counted.datagrams()
-    assert all(d[:2] == MAGIC and HEADER.unpack_from(d)[3] & Flags.BATCH for d in datagrams)
-    per_datagram = (16384 - 0) // (RECORD.size + 64)
-    assert len(datagrams) <= 1000 // per_datagram + 2  # not one datagram a message
+    batches = batched_records(counted.datagrams())
+    assert all(sum(RECORD.size + len(r[2]) for r in b) <= LIMIT for b in batches)
+    records = [r for b in batches for r in b]
+    assert records == [(n + 1, s, p) for n, (s, p) in enumerate(zip(stamps, payloads, strict=True))]
+
+
+def test_only_the_size_bound_splits_batches_while_the_delay_has_not_passed(
+    domain_id: int,
+) -> None:
+    # With a delay that cannot pass during the test, the datagram count is exact: full
+    # batches, then the rest when the flusher is told to send what is pending.
+    counted = Counted(domain_id, delay_s=60.0)
+    try:
+        payloads, stamps = send_thousand(counted)
+        counted.flusher.flush()
+        got = counted.bus.collector.wait_count(1000, timeout=20.0)
+        assert_whole_and_in_order(got, payloads, stamps)
+        batches = batched_records(counted.datagrams())
+        per_datagram = LIMIT // (RECORD.size + 64)
+        assert [len(b) for b in batches] == [per_datagram] * (1000 // per_datagram) + [
+            1000 % per_datagram
+        ]
+        assert len(batches) < 1000 // 10  # several messages a datagram, not one each
+    finally:
+        counted.close()
 
 
 def test_a_lone_message_goes_out_within_the_delay_without_further_sends(
     counted: Counted,
 ) -> None:
-    sent = time.monotonic()
-    counted.bus.writer.send(b"alone")
-    got = counted.bus.collector.wait_count(1, timeout=2.0)
+    counted.bus.writer.send(b"alone")  # nothing fills the batch: only the flusher can send it
+    got = counted.bus.collector.wait_count(1, timeout=20.0)
     assert [bytes(d.payload) for d in got] == [b"alone"]
-    assert time.monotonic() - sent < 1.0
 
 
 def test_a_big_message_after_small_ones_keeps_its_place(counted: Counted) -> None:
@@ -88,7 +135,7 @@ def test_a_big_message_after_small_ones_keeps_its_place(counted: Counted) -> Non
     counted.bus.writer.send(b"two")
     counted.bus.writer.send(big)  # fragmented: the batch must go first
     counted.bus.writer.send(b"three")
-    got = counted.bus.collector.wait_count(4, timeout=5.0)
+    got = counted.bus.collector.wait_count(4, timeout=20.0)
     assert [bytes(d.payload) for d in got] == [b"one", b"two", big, b"three"]
     assert [d.seq for d in got] == [1, 2, 3, 4]
 
@@ -109,7 +156,7 @@ def test_a_malformed_batch_is_counted_and_the_next_one_still_arrives(counted: Co
     )  # fmt: skip
     counted.bus.tx.send(counted.bus.writer.channel, [head + records])
     counted.bus.writer.send(b"fine")
-    got = counted.bus.collector.wait_count(1, timeout=2.0)
+    got = counted.bus.collector.wait_count(1, timeout=10.0)
     assert [bytes(d.payload) for d in got] == [b"fine"]
     assert counted.bus.reader.reassembler.malformed == 1
 
@@ -121,7 +168,7 @@ def test_closing_the_flusher_sends_what_is_pending(domain_id: int) -> None:
         time.sleep(0.2)
         assert counted.bus.collector.snapshot() == []
         counted.flusher.close()
-        got = counted.bus.collector.wait_count(1, timeout=2.0)
+        got = counted.bus.collector.wait_count(1, timeout=10.0)
         assert [bytes(d.payload) for d in got] == [b"pending"]
     finally:
         counted.close()
@@ -132,7 +179,7 @@ def test_after_the_flusher_closed_a_small_message_goes_out_at_once(domain_id: in
     try:
         counted.flusher.close()
         counted.bus.writer.send(b"late")
-        got = counted.bus.collector.wait_count(1, timeout=2.0)
+        got = counted.bus.collector.wait_count(1, timeout=10.0)
         assert [bytes(d.payload) for d in got] == [b"late"]
     finally:
         counted.close()

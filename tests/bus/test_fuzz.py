@@ -76,7 +76,7 @@ def received(listener: Node) -> int:
     return good_count(listener.out.lines)
 
 
-def capture_real_datagrams(domain: int, timeout: float = 10.0) -> tuple[list[bytes], list[bytes]]:
+def capture_real_datagrams(domain: int, timeout: float = 20.0) -> tuple[list[bytes], list[bytes]]:
     """Genuine discovery and data datagrams of the running nodes (to truncate and mutate)."""
     addressing = Addressing(domain)
     disc = open_receiver(addressing, 0)
@@ -242,7 +242,7 @@ def blast(domain: int, datagrams: list[tuple[int, bytes]], batch: int = 100) -> 
 def probe_graph(processes: Processes, *names: str) -> list[str]:
     probe = processes.python(PROBE, *names)
     out, err = Lines(probe.stdout), Lines(probe.stderr)
-    out.wait_for(lambda lines: any(x in ("found", "missing") for x in lines), 20.0)
+    out.wait_for(lambda lines: any(x in ("found", "missing") for x in lines), 40.0)
     wait_exit(probe, 10.0)
     return [*out.rest(2.0), *err.rest(2.0)]
 

@@ -213,4 +213,6 @@ def test_address_record_round_trips() -> None:
 
 def test_module_exports_used_by_wire() -> None:
     assert hdr.HEADER.size == HEADER_SIZE
-    assert {k.name for k in Kind} == {"DATA", "REQUEST", "RESPONSE", "DISCOVERY", "REPLAY"}
+    assert {k.name for k in Kind} == {
+        "DATA", "REQUEST", "RESPONSE", "DISCOVERY", "REPLAY", "FAILURE"
+    }  # fmt: skip

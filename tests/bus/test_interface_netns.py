@@ -140,7 +140,7 @@ def test_publisher_and_subscriber_in_two_namespaces(netns: Namespaces, domain_id
         # discovery crosses too: a fresh process next to the listener sees the talker
         probe = netns.run(b, python(PROBE, "/netns_talker"), env={"ROSL_INTERFACE": vb})
         probe_out, probe_err = Lines(probe.stdout), Lines(probe.stderr)
-        probe_out.wait_for(lambda lines: any(x in ("found", "missing") for x in lines), 20.0)
+        probe_out.wait_for(lambda lines: any(x in ("found", "missing") for x in lines), 40.0)
         assert "found" in probe_out.lines, f"{probe_out.lines} {probe_err.rest(1.0)}"
     finally:
         stop(listener)
@@ -182,10 +182,10 @@ reader = Reader()
 reader.want_all = True
 counts = {c: 0 for c in channels}
 print("ready", flush=True)
-deadline = time.monotonic() + 15
-heard = None
+deadline = time.monotonic() + 60
+heard = None  # 5 s of silence after the last datagram means the sender is done
 while time.monotonic() < deadline and sum(counts.values()) < expected:
-    if heard is not None and time.monotonic() - heard > 2.0:
+    if heard is not None and time.monotonic() - heard > 5.0:
         break
     ready, _, _ = select.select(list(sockets.values()), [], [], 0.1)
     for channel, sock in sockets.items():
@@ -248,7 +248,7 @@ def test_each_channel_socket_gets_only_its_group_across_a_veth(
     )  # fmt: skip
     sent = Lines(sender.stdout)
     assert sent.wait_line("sent", 20.0), Lines(sender.stderr).rest(1.0)
-    line = out.wait_line("{", 25.0)
+    line = out.wait_line("{", 70.0)
     assert line is not None, err.rest(1.0)
     counts = {int(k): v for k, v in json.loads(line).items()}
     misdelivered = {c: n for c, n in counts.items() if c != target and n}
@@ -371,7 +371,7 @@ def test_selftest_reports_one_line_when_own_datagrams_never_return(
             seen.extend(capsys.readouterr().err.splitlines())
             return any("multicast does not work here" in x for x in seen)
 
-        assert wait_until(warned, timeout=SELFTEST_S + 5.0)
+        assert wait_until(warned, timeout=SELFTEST_S + 15.0)
         time.sleep(0.5)  # it is said once, not every period
         warned()
         lines = [x for x in seen if x.strip()]

@@ -232,7 +232,7 @@ def test_unwanted_topics_are_dropped_and_counted(bus: Bus) -> None:
     bus.writer.send(b"marker")
     got = bus.collector.wait_count(1)
     assert [bytes(d.payload) for d in got] == [b"marker"]
-    assert bus.collector.wait_for(lambda _: bus.reader.unwanted == 3, timeout=2.0)
+    assert bus.collector.wait_for(lambda _: bus.reader.unwanted == 3, timeout=10.0)
     assert bus.reader.reassembler.pending == 0
 
 
@@ -278,7 +278,7 @@ def test_foreign_datagrams_are_counted_not_delivered(bus: Bus) -> None:
     bus.writer.send(b"marker")
     got = bus.collector.wait_count(1)
     assert [bytes(d.payload) for d in got] == [b"marker"]
-    assert bus.collector.wait_for(lambda _: bus.reader.foreign == 6, timeout=2.0)
+    assert bus.collector.wait_for(lambda _: bus.reader.foreign == 6, timeout=10.0)
 
 
 def test_single_datagram_with_a_lying_total_is_malformed(bus: Bus) -> None:
@@ -287,7 +287,7 @@ def test_single_datagram_with_a_lying_total_is_malformed(bus: Bus) -> None:
     bus.writer.send(b"marker")
     got = bus.collector.wait_count(1)
     assert [bytes(d.payload) for d in got] == [b"marker"]
-    assert bus.collector.wait_for(lambda _: bus.reader.reassembler.malformed == 1, timeout=2.0)
+    assert bus.collector.wait_for(lambda _: bus.reader.reassembler.malformed == 1, timeout=10.0)
 
 
 # --- addressed datagrams ----------------------------------------------------------------------
@@ -354,7 +354,7 @@ def test_a_stale_partial_message_is_dropped_after_max_age(bus: Bus) -> None:
     time.sleep(bus.reader.reassembler.max_age_ns / 1e9 + 0.3)
     bus.writer.send(b"later traffic")
     assert len(bus.collector.wait_count(2)) == 2
-    bus.collector.wait_for(lambda _: bus.reader.reassembler.pending == 0, timeout=1.0)
+    bus.collector.wait_for(lambda _: bus.reader.reassembler.pending == 0, timeout=10.0)
     assert bus.reader.reassembler.pending == 0, (
         "stale partial never expired (Reader never calls expire)"
     )
@@ -426,9 +426,9 @@ print("ready", flush=True)
 got = []
 done = 0
 deadline = time.monotonic() + 40
-heard = None  # when the last datagram came: 3 s of silence after that means it is over
+heard = None  # when the last datagram came: 10 s of silence after that means it is over
 while done < want and time.monotonic() < deadline:
-    if heard is not None and time.monotonic() - heard > 3.0:
+    if heard is not None and time.monotonic() - heard > 10.0:
         break
     ready, _, _ = select.select([sock], [], [], 0.1)
     if ready:

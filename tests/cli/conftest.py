@@ -14,6 +14,7 @@ import pytest
 
 from rosl.cli.main import main
 from rosl.idl import registry
+from tests.conftest import ChildOutput
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -96,7 +97,31 @@ def timed(processes: Processes, *args: str) -> tuple[Result, float]:
     return result, time.monotonic() - started
 
 
-def wait_graph(check: Callable[[GraphCache], bool], timeout: float = 10.0) -> None:
+def timed_after(
+    processes: Processes, marker: str, *args: str, timeout: float = 60.0
+) -> tuple[Result, float, float]:
+    """:func:`run`, how long it took, and how long it still ran after printing ``marker``.
+
+    The second time leaves out the interpreter's start-up (seconds on a loaded machine), so a
+    bound on it can tell a wait of 1 s from one of 5 s without depending on the machine's speed.
+    """
+    started = time.monotonic()
+    child = processes.rosl(*args, env={"NO_COLOR": "1"})
+    output = ChildOutput(child)
+    deadline = started + timeout
+    marked: float | None = None
+    while output._open and (left := deadline - time.monotonic()) > 0:
+        output._read(min(left, 0.02))
+        if marked is None and marker in output.text["out"]:
+            marked = time.monotonic()
+    child.wait(timeout=max(0.1, deadline - time.monotonic()))
+    ended = time.monotonic()
+    assert marked is not None, f"{marker!r} never printed: {output.text}"
+    result = Result(child.returncode, output.text["out"], output.text["err"])
+    return result, ended - started, ended - marked
+
+
+def wait_graph(check: Callable[[GraphCache], bool], timeout: float = 30.0) -> None:
     """Wait, from a bare participant that shows up nowhere, until the graph passes ``check``."""
     from rosl.introspection.session import Session
 

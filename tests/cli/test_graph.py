@@ -197,9 +197,9 @@ def test_watch_prints_a_new_snapshot_when_a_node_joins(processes: Processes) -> 
     first = Watched(processes.python(ONE_NODE, "first_node"))
     first.wait_ready()
     watcher = Watched(processes.rosl("graph", "--watch", "--text", env={"NO_COLOR": "1"}))
-    assert watcher.wait_for(r"^/first_node$", timeout=15), watcher.text("err")
+    assert watcher.wait_for(r"^/first_node$", timeout=30), watcher.text("err")
     Watched(processes.python(ONE_NODE, "second_node")).wait_ready()
-    assert watcher.wait_for(r"^/second_node$", timeout=15), watcher.text()
+    assert watcher.wait_for(r"^/second_node$", timeout=30), watcher.text()
     assert watcher.interrupt() in (0, 130)
     out = watcher.lines()
     assert "---" in out

@@ -162,10 +162,22 @@ def test_node_info_of_a_shared_name_warns_and_shows_one(start, processes) -> Non
 
 def test_node_info_of_the_tutorial_publisher_started_with_rosl_run(processes) -> None:
     publisher = Watched(processes.rosl("run", "tutorial_pkg", "my_publisher"))
-    assert publisher.wait_for(r"Publishing: counter=1 ", "err", timeout=10.0), publisher.text("err")
+    assert publisher.wait_for(r"Publishing: counter=1 ", "err", timeout=30.0), publisher.text("err")
     result = node(processes, "info", "/my_publisher")
     assert (result.code, result.err) == (0, "")
     lines = result.out.splitlines()
     assert lines[:3] == ["/my_publisher", "  Subscribers:", ""]
     assert "    /my_data: tutorial_pkg/msg/MyData" in lines
     assert lines[-4:] == ["  Action Servers:", "", "  Action Clients:", ""]
+
+
+def test_node_info_of_a_hidden_node_needs_include_hidden_as_ros2(start, processes) -> None:
+    start(NODES, "_hidden_complex_node", "complex_node")
+    result = node(processes, "info", "/_hidden_complex_node")
+    assert result == Result(1, "", "Unable to find node '/_hidden_complex_node'\n")
+    shown = node(processes, "info", "/_hidden_complex_node", "--include-hidden")
+    assert (shown.code, shown.err) == (0, "")
+    assert shown.out.splitlines()[:2] == ["/_hidden_complex_node", "  Subscribers:"]
+    # a misspelt name is only compared with the nodes shown
+    line = assert_user_error(node(processes, "info", "/_hidden_complex_nod"))
+    assert line == "Unable to find node '/_hidden_complex_nod' (did you mean '/complex_node'?)"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import pytest
@@ -182,8 +183,9 @@ def test_param_get_prints_ros2s_label_and_value_for_every_type(param_node, param
         "count": "Integer value is: 5",
         "enabled": "Boolean value is: True",
         "label": "String value is: hello",
-        "gains": "Double values are: [1.0, 2.5]",
-        "ids": "Integer values are: [1, 2, 3]",
+        # humble prints the message fields as rclpy holds them: array.array for numbers
+        "gains": "Double values are: array('d', [1.0, 2.5])",
+        "ids": "Integer values are: array('q', [1, 2, 3])",
         "names": "String values are: ['a', 'b']",
         "flags": "Boolean values are: [True, False]",
         "limits.min": "Double value is: -1.5",
@@ -193,15 +195,18 @@ def test_param_get_prints_ros2s_label_and_value_for_every_type(param_node, param
     hidden = param("get", "/param_node", "speed", "--hide-type")
     assert (hidden.code, hidden.out, hidden.err) == (0, "2.0\n", "")
     assert param("get", "/param_node", "names", "--hide-type").out == "['a', 'b']\n"
+    assert param("get", "/param_node", "ids", "--hide-type").out == "array('q', [1, 2, 3])\n"
 
 
 def test_param_get_of_an_unknown_parameter_or_node_names_the_closest_one(param_node, param) -> None:
-    line = assert_user_error(param("get", "/param_node", "sped"), "Parameter not set", "sped")
-    assert "(did you mean 'speed'" in line
-    line = assert_user_error(
-        param("get", "/param_nod", "speed"), "Unable to find node '/param_nod'"
-    )
-    assert line.endswith("(did you mean '/param_node'?)")
+    line = assert_user_error(param("get", "/param_node", "sped"))
+    assert line == "Parameter not set (did you mean 'speed' or 'shared'?)"
+    assert assert_user_error(param("get", "/param_node", "xyzzy")) == "Parameter not set"
+    line = assert_user_error(param("get", "/param_nod", "speed"))
+    assert line == "Node not found (did you mean '/param_node'?)"
+    for verb in (("get", "x"), ("set", "x", "1"), ("delete", "x"), ("describe", "x"), ("dump",)):
+        result = param(verb[0], "/invalid_node", *verb[1:])
+        assert assert_user_error(result) == "Node not found", verb
 
 
 # --- set --------------------------------------------------------------------------------------
@@ -217,7 +222,7 @@ def test_param_set_prints_set_parameter_successful_and_the_node_takes_the_value(
     assert (negative.code, negative.out, negative.err) == (0, "Set parameter successful\n", "")
     assert get(param, "speed") == "Double value is: -3.5\n"
     assert param("set", "/param_node", "ids", "[4, -5]").out == "Set parameter successful\n"
-    assert get(param, "ids") == "Integer values are: [4, -5]\n"
+    assert get(param, "ids") == "Integer values are: array('q', [4, -5])\n"
     assert param("set", "/param_node", "label", "two words").code == 0
     assert get(param, "label") == "String value is: two words\n"
 
@@ -316,11 +321,21 @@ def test_param_dump_prints_ros2s_yaml_and_output_dir_writes_it(
     param_node, param, tmp_path: Path
 ) -> None:
     result = param("dump", "/param_node")
-    assert (result.code, result.out, result.err) == (0, DUMP, "")
+    assert (result.code, result.out, result.err) == (0, DUMP + "\n", "")  # print()'s blank line
+    (tmp_path / "out").mkdir()
     saved = param("dump", "/param_node", "--output-dir", str(tmp_path / "out"))
     assert saved.code == 0, saved
     assert saved.out == f"Saving to:  {tmp_path / 'out' / 'param_node.yaml'}\n"
+    assert saved.err == "WARNING: '--output-dir' is deprecated; use redirection to save to a file\n"
     assert (tmp_path / "out" / "param_node.yaml").read_text() == DUMP
+
+
+def test_param_dump_to_a_missing_folder_is_ros2s_error(param_node, param, tmp_path: Path) -> None:
+    missing = str(tmp_path / "invalid_path")
+    result = param("dump", "/param_node", "--output-dir", missing)
+    assert result.out == ""
+    assert assert_user_error(result) == f"'{missing}' is not a valid directory."
+    assert not (tmp_path / "invalid_path").exists()
 
 
 def test_param_load_of_a_dump_sets_each_parameter_and_says_so(
@@ -336,7 +351,7 @@ def test_param_load_of_a_dump_sets_each_parameter_and_says_so(
         "Set parameter frame failed: Trying to set a read-only parameter: frame.\n"
     )
     assert get(param, "speed") == "Double value is: 3.25\n"
-    assert get(param, "gains") == "Double values are: [1.0, 7.5]\n"
+    assert get(param, "gains") == "Double values are: array('d', [1.0, 7.5])\n"
     assert get(param, "limits.max") == "Double value is: 9.5\n"
 
 
@@ -435,15 +450,67 @@ PERIOD_CHANGED = r"\[timer_node\]: Timer period changed to 0\.5 s"
 
 def test_the_seeds_param_set_changes_the_running_timer_nodes_period(processes, param) -> None:
     node = Watched(processes.rosl("run", "tutorial_pkg", "timer_node"))
-    assert node.wait_for(r"\[timer_node\]: Timer period: 2\.0 s", "err", timeout=10.0), node.text(
+    assert node.wait_for(r"\[timer_node\]: Timer period: 2\.0 s", "err", timeout=30.0), node.text(
         "err"
     )
     result = param("set", "/timer_node", "timer_period_s", "0.5")
     assert (result.code, result.out, result.err) == (0, "Set parameter successful\n", "")
-    assert node.wait_for(PERIOD_CHANGED, "err", timeout=5.0), node.text("err")
-    assert node.wait_for(r"Tick \d+ \(period 0\.5 s\)", "err", timeout=5.0), node.text("err")
+    assert node.wait_for(PERIOD_CHANGED, "err", timeout=15.0), node.text("err")
+    assert node.wait_for(r"Tick \d+ \(period 0\.5 s\)", "err", timeout=15.0), node.text("err")
 
     refused = param("set", "/timer_node", "timer_period_s", "-1.0")
     assert (refused.code, refused.out) == (1, "")
     assert refused.err == "Setting parameter failed: timer_period_s must be > 0\n"
     assert param("get", "/timer_node", "timer_period_s").out == "Double value is: 0.5\n"
+
+
+@pytest.mark.parametrize(
+    ("value", "reason"),
+    [
+        (".nan", "ValueError: cannot convert float NaN to integer"),
+        ("1.0e+300", "OverflowError: cannot convert float infinity to integer"),
+    ],
+    ids=["nan", "huge"],
+)
+def test_param_set_that_makes_the_nodes_callback_raise_fails_and_the_node_keeps_running(
+    processes, param, value: str, reason: str
+) -> None:
+    # the tutorial's callback refuses <= 0 but turns nan/1e300 into an int: it raises
+    node = Watched(processes.rosl("run", "tutorial_pkg", "timer_node", "--ros-args", "-p",
+                                  "timer_period_s:=0.5"))  # fmt: skip
+    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.5 s", "err", timeout=30.0), node.text(
+        "err"
+    )
+
+    failed = param("set", "/timer_node", "timer_period_s", value)
+
+    assert (failed.code, failed.out) == (1, ""), failed
+    assert failed.err == f"Setting parameter failed: {reason}\n"
+    logged = "exception in callback for on_set_parameters: " + re.escape(reason)
+    assert node.wait_for(logged, "err", timeout=15.0), node.text("err")
+    assert param("get", "/timer_node", "timer_period_s").out == "Double value is: 0.5\n"
+    ticks = len(node.matching(r"Tick \d+ \(period 0\.5 s\)", "err"))
+    assert node.wait_for(r"Tick \d+ \(period 0\.5 s\)", "err", timeout=15.0, count=ticks + 1)
+    assert node.interrupt() == 0, node.text("err")
+
+
+HIDDEN_NODE = """
+import rosl
+
+rosl.init([])
+node = rosl.Node("_hidden_params")
+node.declare_parameter("level", 3)
+print("ready", flush=True)
+rosl.spin(node)
+rosl.shutdown()
+"""
+
+
+def test_a_hidden_node_is_found_only_with_include_hidden_nodes(processes, param) -> None:
+    Watched(processes.python(HIDDEN_NODE)).wait_ready()
+    assert assert_user_error(param("get", "/_hidden_params", "level")) == "Node not found"
+    assert assert_user_error(param("list", "/_hidden_params")) == "Node not found"
+    found = param("get", "/_hidden_params", "level", "--include-hidden-nodes")
+    assert (found.code, found.out, found.err) == (0, "Integer value is: 3\n", "")
+    listed = param("list", "/_hidden_params", "--include-hidden-nodes")
+    assert listed.out == "  level\n  use_sim_time\n"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import re
 from typing import TYPE_CHECKING
 
@@ -36,12 +37,12 @@ def test_the_tutorial_subscriber_hears_the_tutorial_publisher_counting_up(
     tutorial: Callable[..., Watched], observer_node: Node
 ) -> None:
     subscriber = tutorial("my_subscriber")
-    assert observer_node.wait_for_node("/my_subscriber", 10.0), subscriber.text("err")
-    assert wait_until(lambda: observer_node.count_subscribers("/my_data") == 1, timeout=10.0)
+    assert observer_node.wait_for_node("/my_subscriber", 30.0), subscriber.text("err")
+    assert wait_until(lambda: observer_node.count_subscribers("/my_data") == 1, timeout=30.0)
 
     publisher = tutorial("my_publisher")
 
-    assert subscriber.wait_for(HEARD, "err", timeout=10.0, count=3), (
+    assert subscriber.wait_for(HEARD, "err", timeout=30.0, count=3), (
         f"subscriber:\n{subscriber.text('err')}\npublisher:\n{publisher.text('err')}"
     )
     counters = [int(m.group(1)) for m in subscriber.matching(HEARD, "err")]
@@ -61,29 +62,25 @@ def test_the_count_images_service_counts_the_images_in_a_folder(
 
     server = tutorial("count_images")
     client = observer_node.create_client(CountImages, "/count_images")
-    assert client.wait_for_service(timeout_sec=10.0), server.text("err")
+    assert client.wait_for_service(timeout_sec=30.0), server.text("err")
 
     folder = tmp_path / "pictures"
     folder.mkdir()
     for name in ("a.png", "b.png", "c.png", "notes.txt"):
         (folder / name).write_bytes(b"\x89PNG" if name.endswith(".png") else b"text")
 
-    response = client.call(CountImages.Request(folder_path=str(folder)), timeout_sec=10.0)
+    response = client.call(CountImages.Request(folder_path=str(folder)), timeout_sec=30.0)
 
     assert response.count == 3
     assert response.message == f"3 image(s) in {folder}"
-    assert server.wait_for(re.escape(f"3 image(s) in {folder}"), "err", timeout=5.0)
+    assert server.wait_for(re.escape(f"3 image(s) in {folder}"), "err", timeout=15.0)
 
     missing = tmp_path / "no_such_folder"
-    response = client.call(CountImages.Request(folder_path=str(missing)), timeout_sec=10.0)
+    response = client.call(CountImages.Request(folder_path=str(missing)), timeout_sec=30.0)
 
     assert response.count == 0
     assert response.message == f"not a folder: {missing}"
     assert_clean_exit(server)
-
-
-def ticks_in_window(ticks: list[tuple[float, int, float]], start: float, length: float) -> int:
-    return sum(1 for stamp, _, _ in ticks if start <= stamp < start + length)
 
 
 @pytest.mark.slow
@@ -95,25 +92,25 @@ def test_the_timer_node_ticks_at_its_parameter_period_and_speeds_up_when_it_is_s
     from rosl import Parameter
 
     node = tutorial("timer_node", "--ros-args", "-p", "timer_period_s:=0.25")
-    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.25 s", "err", timeout=10.0), node.text(
+    assert node.wait_for(r"\[timer_node\]: Timer period: 0\.25 s", "err", timeout=30.0), node.text(
         "err"
     )
-    assert node.wait_for(TICK, "err", timeout=10.0, count=8)  # 2 s of ticks at 4 Hz
+    assert node.wait_for(TICK, "err", timeout=30.0, count=8)  # 2 s of ticks at 4 Hz
 
     client = observer_node.create_client(SetParameters, "/timer_node/set_parameters")
-    assert client.wait_for_service(timeout_sec=10.0)
+    assert client.wait_for_service(timeout_sec=30.0)
     request = SetParameters.Request(
         parameters=[Parameter("timer_period_s", value=0.1).to_parameter_msg()]
     )
-    response = client.call(request, timeout_sec=10.0)
+    response = client.call(request, timeout_sec=30.0)
     assert [r.successful for r in response.results] == [True]
-    assert node.wait_for(PERIOD_CHANGED, "err", timeout=5.0)
+    assert node.wait_for(PERIOD_CHANGED, "err", timeout=15.0)
     changed_at = float(node.matching(PERIOD_CHANGED, "err")[0].group(1))
 
     def ticks() -> list[tuple[float, int, float]]:
         return [(float(m[1]), int(m[2]), float(m[3])) for m in node.matching(TICK, "err")]
 
-    assert wait_until(lambda: sum(1 for t in ticks() if t[0] > changed_at) >= 17, timeout=10.0)
+    assert wait_until(lambda: sum(1 for t in ticks() if t[0] > changed_at) >= 17, timeout=30.0)
     assert_clean_exit(node)
 
     every = ticks()
@@ -123,11 +120,20 @@ def test_the_timer_node_ticks_at_its_parameter_period_and_speeds_up_when_it_is_s
     assert {period for _, _, period in before} == {0.25}
     assert {period for _, _, period in after} == {0.1}
 
-    # windows of 1.5 s on the node's own clock (its log stamps), so reading delays don't count
-    slow = ticks_in_window(before, before[0][0], 1.5)
-    fast = ticks_in_window(after, after[0][0], 1.5)
-    assert 3 <= slow <= 9, f"{slow} ticks in 1.5 s at a 0.25 s period"
-    assert fast > slow, f"{fast} ticks in 1.5 s after the change vs {slow} before"
+    # on the node's own clock (its log stamps), so reading delays don't count. A loaded machine
+    # only makes a tick late (the timer then skips to its next slot), never early: tick k comes
+    # more than k - 1 periods after the first, whatever the load
+    for run, period in ((before, 0.25), (after, 0.1)):
+        early = [
+            (k, t - run[0][0])
+            for k, (t, _, _) in enumerate(run)
+            if t - run[0][0] <= (k - 1) * period
+        ]
+        assert early == [], f"ticks earlier than their {period} s period allows: {early}"
+    # and it did speed up: most gaps are one new period (a gap of the old 0.25 s would need a
+    # late tick, and the timer skipping a slot, for more than half of them)
+    gaps = sorted(b[0] - a[0] for a, b in itertools.pairwise(after))
+    assert gaps[len(gaps) // 2] < 0.2, f"median gap {gaps[len(gaps) // 2]:.3f} s at a 0.1 s period"
 
 
 EXECUTABLES = {
@@ -147,7 +153,7 @@ def test_ctrl_c_stops_a_tutorial_node_cleanly_and_it_leaves_the_graph_at_once(
     graph = observer_node.participant.graph
     record = wait_for_node(graph, f"/{executable}")
     if busy is not None:  # let it get going first
-        assert child.wait_for(busy, "err", timeout=10.0), child.text("err")
+        assert child.wait_for(busy, "err", timeout=30.0), child.text("err")
 
     timing = leaving_time(graph, record.process, child.send, 3 * LEASE_S)
 

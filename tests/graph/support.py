@@ -61,7 +61,7 @@ class Watched:
         return [m for m in found if m is not None]
 
     def wait_for(
-        self, pattern: str, stream: str = "out", timeout: float = 10.0, count: int = 1
+        self, pattern: str, stream: str = "out", timeout: float = 30.0, count: int = 1
     ) -> bool:
         """Wait until ``count`` lines match ``pattern`` (or the child ends, or the timeout)."""
         deadline = time.monotonic() + timeout
@@ -75,7 +75,7 @@ class Watched:
                     return False
                 self._changed.wait(min(left, 0.1))
 
-    def wait_ready(self, timeout: float = 10.0) -> None:
+    def wait_ready(self, timeout: float = 30.0) -> None:
         """Wait for the child's ``ready`` line; fail with its output if it never comes."""
         if not self.wait_for(r"^ready\b", "out", timeout):
             raise AssertionError(
@@ -98,7 +98,7 @@ class Watched:
             self.child.send_signal(sig)
         self.signalled = True
 
-    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 10.0) -> int | None:
+    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 20.0) -> int | None:
         """Ctrl-C the child (unless already signalled) and wait; return the exit code."""
         if not self.signalled:
             self.send(sig)
@@ -111,7 +111,7 @@ class Watched:
         return code
 
 
-def wait_for_node(graph: GraphCache, fqn: str, timeout: float = 10.0) -> NodeRecord:
+def wait_for_node(graph: GraphCache, fqn: str, timeout: float = 30.0) -> NodeRecord:
     """Wait until ``fqn`` is in the graph; return its record."""
     assert graph.wait_for(lambda: bool(graph.find_node(fqn)), timeout), (
         f"{fqn} never showed up; the graph has {[n.fqn for n in graph.nodes()]}"
@@ -139,6 +139,10 @@ def leaving_time(
         return True
 
     assert not gone(), "the process was not in the graph to begin with"
+    # act right after a fresh announcement from it, so that nearly the whole lease is left:
+    # a goodbye then only has to be handled within the lease, however loaded the machine is
+    before = last_seen
+    wait_until(lambda: gone() or last_seen > before, timeout=10.0, interval=0.005)
     act()
     if not wait_until(gone, timeout=timeout, interval=0.005):
         return None

@@ -184,8 +184,8 @@ def random_value(message_cls, name, ftype, rng, depth):
         value = rng.uniform(-1e3, 1e3)
         return float(np.float32(value)) if base == "float32" else value
     low, high = INTEGER_RANGES[base]
-    if base == "byte":
-        low, high = -128, 127
+    if base == "byte":  # rclpy's bytes of length 1
+        return bytes([rng.randint(0, 255)])
     return rng.randint(low, high)
 
 
@@ -197,6 +197,10 @@ def to_rosbags(message: Message):
             value = to_rosbags(value)
         elif isinstance(value, list) and not ftype.is_primitive:
             value = [to_rosbags(v) for v in value]
+        elif ftype.base == "byte" and ftype.is_array:  # rosbags: an int8 array
+            value = np.frombuffer(b"".join(value), dtype=np.int8)
+        elif ftype.base == "byte":  # rosbags: a signed int
+            value = int.from_bytes(value, "little", signed=True)
         kwargs[name] = value
     return HUMBLE.types[message.__msgtype__](**kwargs)
 
@@ -212,3 +216,99 @@ def test_cdr_is_byte_identical_to_rosbags_and_round_trips(type_name):
         theirs = bytes(HUMBLE.serialize_cdr(to_rosbags(message), type_name))
         assert ours == theirs
         assert store.deserialize(ours, type_name) == message
+
+
+# --- byte and bounded sequences as rclpy has them -----------------------------------------------
+
+BYTES_MSG = """\
+byte K=200
+byte b 255
+byte[3] fixed [0, 1, 255]
+byte[] seq
+byte[<=2] bounded
+char c 65
+uint8 u
+string[<=3] names
+string[2] pair
+"""
+
+
+@pytest.fixture
+def bytes_cls(make_package) -> type[Message]:
+    make_package("bytes_pkg", {"msg/Bytes.msg": BYTES_MSG})
+    return cls("bytes_pkg/msg/Bytes")
+
+
+def test_byte_fields_hold_bytes_of_length_one_and_char_an_int_as_rclpy_does(bytes_cls):
+    message = bytes_cls()
+
+    assert message.b == b"\xff"
+    assert message.fixed == [b"\x00", b"\x01", b"\xff"]
+    assert (message.seq, message.bounded) == ([], [])
+    assert (message.c, message.u) == (65, 0)
+    assert bytes_cls.K == b"\xc8"
+    assert bytes_cls.FIXED__DEFAULT == [b"\x00", b"\x01", b"\xff"]
+    assert cls("std_msgs/msg/Byte")().data == b"\x00"
+    assert "b=b'\\xff', fixed=[b'\\x00', b'\\x01', b'\\xff'], seq=[]" in repr(message)
+
+
+def test_byte_fields_take_bytes_and_numbers_up_to_255_and_refuse_the_rest(bytes_cls):
+    message = bytes_cls(b=7, seq=b"\x00\xfe", bounded=[1, b"\x02"])
+    assert message.b == b"\x07"
+    assert (message.seq, message.bounded) == ([b"\x00", b"\xfe"], [b"\x01", b"\x02"])
+    message.fixed = bytearray(b"abc")
+    assert message.fixed == [b"a", b"b", b"c"]
+    with pytest.raises(FieldError, match=r"Bytes field 'b': expects a byte .*got int 256"):
+        message.b = 256
+    with pytest.raises(FieldError, match=r"field 'b': expects a byte .*got bytes b'ab'"):
+        message.b = b"ab"
+    with pytest.raises(FieldError, match=r"field 'fixed': needs exactly 3 values, got 2"):
+        message.fixed = [1, 2]
+    with pytest.raises(FieldError, match=r"field 'bounded': holds at most 2 values, got 3"):
+        message.bounded = b"xyz"
+
+
+def test_bounded_sequences_of_strings_start_empty_and_fixed_arrays_filled(bytes_cls):
+    message = bytes_cls()
+    assert message.names == []
+    assert message.pair == ["", ""]
+    assert cls("std_msgs/msg/MultiArrayLayout")().dim == []
+
+
+def test_byte_fields_go_on_the_wire_as_ros_writes_them_and_come_back_as_bytes(bytes_cls):
+    store = registry.store()
+    message = bytes_cls(seq=[0x7F, 0x80], bounded=[b"\x10"])
+    raw = store.serialize(message)
+
+    assert raw[4:8] == b"\xff\x00\x01\xff"  # b, then fixed
+    assert raw[8:16] == b"\x02\x00\x00\x00\x7f\x80\x00\x00"  # seq: its length, then the bytes
+    back = store.deserialize(raw, "bytes_pkg/msg/Bytes")
+    assert back == message
+    assert back.b == b"\xff"
+    assert back.seq == [b"\x7f", b"\x80"]
+
+
+def test_a_byte_array_item_set_by_hand_that_is_no_byte_is_named_on_serializing(bytes_cls):
+    message = bytes_cls()
+    message.seq.append("too long")
+    with pytest.raises(FieldError, match=r"bytes_pkg/msg/Bytes\.seq\[0\]: expects a byte"):
+        registry.store().serialize(message)
+
+
+def test_byte_fields_from_yaml_values_and_to_ros2_yaml_and_csv(bytes_cls):
+    from rosl.idl.yaml_io import message_to_csv, message_to_yaml, parse_yaml_mapping
+
+    data = parse_yaml_mapping(
+        "{b: 65, seq: [0, 255], bounded: !!binary AQI=, fixed: ['a', 'b', 'c']}"
+    )
+    message = from_dict(bytes_cls, data)
+
+    assert message.b == b"A"
+    assert message.seq == [b"\x00", b"\xff"]
+    assert message.bounded == [b"\x01", b"\x02"]
+    assert message.fixed == [b"a", b"b", b"c"]
+    text = message_to_yaml(message)
+    assert text.startswith('b: A\nfixed:\n- a\n- b\n- c\nseq:\n- "\\0"\n- ÿ\nbounded:\n- "\\x01"\n')
+    assert message_to_csv(message).startswith("b'A',b'a',b'b',b'c',b'\\x00',b'\\xff',b'\\x01'")
+    with pytest.raises(FieldError, match=r"^b: expects a byte .*got str 'AB'"):
+        from_dict(bytes_cls, {"b": "AB"})

@@ -111,6 +111,31 @@ def test_parser_reports_bad_array_bound(line, bound):
     assert f"bad array bound '{bound}'" in message
 
 
+@pytest.mark.parametrize(
+    ("line", "limit", "kind"),
+    [
+        ("int32[100000000000] big", 2**26, "numbers"),
+        ("string[70000] names", 2**16, "strings"),
+        ("geometry_msgs/Point[70000] points", 2**16, "messages"),
+    ],
+    ids=["numbers", "strings", "messages"],
+)
+def test_parser_refuses_a_fixed_array_too_large_to_construct_at_its_size(line, limit, kind):
+    token = line.split()[0]
+    size = token[token.index("[") + 1 : -1]
+    message = error_of(f"int32 a\n{line}\n")
+    assert message == (
+        f"msg/Thing.msg:2:{token.index('[') + 2}: fixed array '{token}' is too large: {size} "
+        f"elements, at most {limit} for {kind} (use a sequence '{token[: token.index('[')]}[]' "
+        "for big data)"
+    )
+
+
+def test_parser_accepts_fixed_arrays_up_to_the_limits_and_any_sequence_bound():
+    spec = parse(f"uint8[{2**26}] image\nstring[{2**16}] names\nint32[<=100000000000] many\n")
+    assert [f.type.size for f in spec.fields] == [2**26, 2**16, 100000000000]
+
+
 def test_parser_reports_bad_string_bound():
     assert "bad string bound '0'" in error_of("string<=0 s\n")
 

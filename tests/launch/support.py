@@ -85,7 +85,7 @@ class Output:
         return [m for m in found if m is not None]
 
     def wait_for(
-        self, pattern: str, stream: str = "out", timeout: float = 10.0, count: int = 1
+        self, pattern: str, stream: str = "out", timeout: float = 30.0, count: int = 1
     ) -> bool:
         """Wait until ``count`` lines match ``pattern``; False at the deadline or at EOF."""
         deadline = time.monotonic() + timeout
@@ -97,7 +97,7 @@ class Output:
                 return False
             self._pump(min(left, 0.2))
 
-    def finish(self, timeout: float = 10.0) -> int | None:
+    def finish(self, timeout: float = 30.0) -> int | None:
         """Read to the end and wait for the exit; the exit code, or None at the deadline."""
         deadline = time.monotonic() + timeout
         while self._open and time.monotonic() < deadline:
@@ -107,7 +107,7 @@ class Output:
         except subprocess.TimeoutExpired:
             return None
 
-    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 15.0) -> int | None:
+    def interrupt(self, sig: int = signal.SIGINT, timeout: float = 30.0) -> int | None:
         """Send ``sig`` once (by pid) and wait for the exit."""
         if self.child.poll() is None:
             self.child.send_signal(sig)
@@ -156,7 +156,9 @@ def running(pid: int, *, allow_unreaped: bool = False) -> bool:
     return state != "Z"
 
 
-def assert_all_gone(pids: list[int], timeout: float = 5.0, *, allow_unreaped: bool = False) -> None:
+def assert_all_gone(
+    pids: list[int], timeout: float = 15.0, *, allow_unreaped: bool = False
+) -> None:
     """Every pid must be gone (os.kill(pid, 0) raising ProcessLookupError) within ``timeout``."""
     assert pids, "no launched pids to check"
     wait_until(lambda: not any(running(p, allow_unreaped=allow_unreaped) for p in pids), timeout)
@@ -185,7 +187,7 @@ class Rosl:
         self.watched.append(output)
         return output
 
-    def run(self, *args: str, timeout: float = 15.0) -> tuple[int | None, str, str]:
+    def run(self, *args: str, timeout: float = 60.0) -> tuple[int | None, str, str]:
         """Run ``rosl ARGS...`` to the end: (exit code, stdout, stderr)."""
         output = self.start(*args)
         code = output.finish(timeout)

@@ -67,7 +67,7 @@ def test_group_with_push_ros_namespace_puts_its_nodes_under_the_namespace(
     launch = rosl.start("launch", str(path))
 
     assert launch.wait_for(r"process started with pid", count=2), launch.both()
-    assert wait_until(lambda: {"/ns/inside", "/outside"} <= set(node_list(rosl)), timeout=10.0), (
+    assert wait_until(lambda: {"/ns/inside", "/outside"} <= set(node_list(rosl)), timeout=60.0), (
         f"{node_list(rosl)}\n{launch.both()}"
     )
     assert "/inside" not in node_list(rosl)
@@ -359,7 +359,7 @@ def test_emit_shutdown_on_a_process_exit_ends_the_whole_launch(
     launch = rosl.start("launch", str(path))
 
     # nobody interrupts it: the Shutdown event alone must end the launch
-    assert launch.finish(timeout=15.0) == 0, launch.both()
+    assert launch.finish(timeout=30.0) == 0, launch.both()
     assert launch.matching(r"^\[INFO\] \[quick-2\]: process has finished cleanly")
     assert launch.matching(r"\[sleeper-1\]: process has (finished|died)"), launch.both()
     assert len(launch.pids()) == 2
@@ -478,7 +478,7 @@ def test_a_parameter_from_a_launch_configuration_is_typed_by_yaml_rules(
 
     launch = rosl.start("launch", str(path), "period:=0.9")
 
-    assert launch.wait_for(r"\[timer_node\]: Timer period: 0\.9 s$", timeout=5.0), launch.both()
+    assert launch.wait_for(r"\[timer_node\]: Timer period: 0\.9 s$", timeout=30.0), launch.both()
     stop(launch)
 
 

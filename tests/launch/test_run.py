@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.conftest import write_package
-from tests.launch.support import one_error_line
+from tests.launch.support import PYTHON, Output, assert_all_gone, one_error_line, write_launch
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -230,3 +230,192 @@ def test_run_from_outside_the_workspace_names_the_workspace_that_has_the_package
         f"; it is in {src / 'seed_pkg'}, a workspace not active here: run rosl from inside "
         f"{home / 'ros2_ws'} or export ROSL_PACKAGE_PATH={src}"
     )
+
+
+def shadowing_folder(tmp_path: Path, init: str | None) -> Path:
+    """A current folder holding a ``rosl/`` folder (a clone of rosl, say) that is not rosl."""
+    folder = tmp_path / "home"
+    (folder / "rosl").mkdir(parents=True)
+    if init is not None:
+        (folder / "rosl" / "__init__.py").write_text(init)
+    return folder
+
+
+def start_in(rosl: Rosl, cwd: Path, *args: str) -> Output:
+    """Start ``rosl ARGS`` from ``cwd`` as the installed ``rosl`` script does (cwd not on path)."""
+    output = Output(rosl.processes.start([PYTHON, "-P", "-m", "rosl", *args], cwd=cwd))
+    rosl.watched.append(output)
+    return output
+
+
+@pytest.mark.parametrize(
+    "init", [None, "raise ImportError('not rosl')\n"], ids=["empty", "bogus-init"]
+)
+def test_run_starts_the_node_when_the_current_folder_holds_a_rosl_folder(
+    rosl: Rosl, tmp_path: Path, init: str | None
+) -> None:
+    # `cd ~ && rosl run ...` with an editable clone in ~/rosl: `python -m` put the current
+    # folder first on sys.path, so ~/rosl shadowed the installed package
+    home = shadowing_folder(tmp_path, init)
+
+    node = start_in(rosl, home, "run", "tutorial_pkg", "timer_node")
+
+    assert node.wait_for(r"\[timer_node\]: Timer period: 2\.0 s$", "err"), node.both()
+    assert node.interrupt() == 0, node.both()
+    assert "Traceback" not in node.text("err")
+
+
+def test_launch_starts_the_nodes_when_the_current_folder_holds_a_rosl_folder(
+    rosl: Rosl, tmp_path: Path, launch_dir: Path
+) -> None:
+    home = shadowing_folder(tmp_path, "raise ImportError('not rosl')\n")
+    path = write_launch(
+        launch_dir,
+        "timer.launch.py",
+        """
+        from launch import LaunchDescription
+        from launch_ros.actions import Node
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                Node(package="tutorial_pkg", executable="timer_node", output="screen"),
+            ])
+        """,
+    )
+
+    launch = start_in(rosl, home, "launch", str(path))
+
+    assert launch.wait_for(r"\[timer_node\]: Timer period: 2\.0 s$"), launch.both()
+    pids = launch.pids()
+    assert launch.interrupt() == 0, launch.both()
+    assert "Traceback" not in launch.text("err")
+    assert_all_gone(pids)
+
+
+TYPO_MANIFEST = """<?xml version="1.0"?>
+<package format="3">
+  <name>typo_pkg</name>
+  <version>0.0.0</version>
+  <export>
+    <rosl>
+      <executable name="timer_node">typo_pkg.timer_nod:main</executable>
+      <executable name="talker">typo_pkg.timer_node:mian</executable>
+      <executable name="listener">typo_pkg.listener:main</executable>
+    </rosl>
+  </export>
+</package>
+"""
+
+LISTENER = """import rclpy
+
+from typo_pkg.msg import MyDta
+
+
+def main():
+    rclpy.init()
+"""
+
+
+@pytest.fixture
+def typo_pkg(make_package: Callable[..., Path]) -> Path:
+    """A package whose executables point at a misspelt module and function, and import a typo."""
+    return make_package(
+        "typo_pkg",
+        {
+            "msg/MyData.msg": "int32 counter\n",
+            "typo_pkg/__init__.py": "",
+            "typo_pkg/timer_node.py": "def main():\n    pass\n\n\ndef helper():\n    pass\n",
+            "typo_pkg/listener.py": LISTENER,
+        },
+        manifest=TYPO_MANIFEST,
+    )
+
+
+@pytest.mark.parametrize(
+    ("executable", "message"),
+    [
+        (
+            "timer_node",
+            "package.xml:7: executable 'timer_node': module 'typo_pkg.timer_nod' not found "
+            "(did you mean 'typo_pkg.timer_node'?)",
+        ),
+        (
+            "talker",
+            "package.xml:8: executable 'talker': module 'typo_pkg.timer_node' has no function "
+            "'mian' (did you mean 'main'?)",
+        ),
+        (
+            "listener",
+            "typo_pkg/listener.py:3: cannot import name 'MyDta' from 'typo_pkg.msg' "
+            "(did you mean 'MyData'?)",
+        ),
+    ],
+    ids=["module", "function", "interface"],
+)
+def test_run_reports_a_misspelt_name_in_one_line_naming_the_file_and_the_closest_name(
+    rosl: Rosl, typo_pkg: Path, executable: str, message: str
+) -> None:
+    code, out, err = rosl.run("run", "typo_pkg", executable)
+
+    assert code == 1, err
+    assert out == ""
+    line = one_error_line(err)
+    assert str(typo_pkg) in line
+    assert line.endswith(message), line
+
+
+def test_launch_shows_a_misspelt_executable_module_as_the_process_line(
+    rosl: Rosl, typo_pkg: Path, launch_dir: Path
+) -> None:
+    path = write_launch(
+        launch_dir,
+        "typos.launch.py",
+        """
+        from launch import LaunchDescription
+        from launch_ros.actions import Node
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                Node(package="typo_pkg", executable="timer_node", output="screen"),
+                Node(package="typo_pkg", executable="listener", output="screen"),
+            ])
+        """,
+    )
+
+    launch = rosl.start("launch", str(path))
+
+    assert launch.finish() not in (0, None), launch.both()
+    assert launch.matching(
+        r"^\[timer_node-1\] \S+/package\.xml:7: executable 'timer_node': module "
+        r"'typo_pkg\.timer_nod' not found \(did you mean 'typo_pkg\.timer_node'\?\)$"
+    ), launch.both()
+    assert launch.matching(
+        r"^\[listener-2\] listener: \S+/typo_pkg/listener\.py:3: cannot import name 'MyDta' "
+        r"from 'typo_pkg\.msg' \(did you mean 'MyData'\?\)$"
+    ), launch.both()
+    assert "Traceback" not in launch.text("out") + launch.text("err")
+    assert_all_gone(launch.pids())
+
+
+@pytest.mark.parametrize(("written", "shown"), [("-5.0", "-5.0"), (".nan", "nan")])
+def test_run_with_a_params_file_period_that_no_timer_can_have_reports_one_line(
+    rosl: Rosl, tmp_path: Path, written: str, shown: str
+) -> None:
+    params = tmp_path / "params.yaml"
+    params.write_text(f"timer_node:\n  ros__parameters:\n    timer_period_s: {written}\n")
+
+    code, out, err = rosl.run(
+        "run", "tutorial_pkg", "timer_node", "--ros-args", "--params-file", str(params)
+    )
+
+    assert code == 1, err
+    assert out == ""
+    line = one_error_line(err)
+    assert line.startswith("timer_node: "), line
+    assert "tutorial_pkg/timer_node.py:" in line  # the create_timer call
+    assert line.endswith(
+        f"create_timer: timer_period_sec must be a finite number > 0, got {shown} "
+        "(the value of parameter 'timer_period_s')"
+    ), line

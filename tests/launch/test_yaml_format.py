@@ -103,7 +103,7 @@ def test_a_yaml_node_parameter_value_may_use_a_launch_argument(
 
     launch = rosl.start("launch", str(path), "period:=0.9")
 
-    assert launch.wait_for(r"\[yaml_timer\]: Timer period: 0\.9 s$", timeout=5.0), launch.both()
+    assert launch.wait_for(r"\[yaml_timer\]: Timer period: 0\.9 s$", timeout=30.0), launch.both()
     stop(launch)
 
 

@@ -30,7 +30,7 @@ class Child(ChildOutput):
 
     # --- reading ---------------------------------------------------------------------------
 
-    def wait_for(self, pattern: str, *, stream: str = "out", timeout: float = 10.0) -> Any:
+    def wait_for(self, pattern: str, *, stream: str = "out", timeout: float = 30.0) -> Any:
         """The next match of ``pattern`` (multiline regex) after the last one, or None."""
         regex = re.compile(pattern, re.MULTILINE)
         deadline = time.monotonic() + timeout
@@ -47,7 +47,7 @@ class Child(ChildOutput):
                 last_look = True  # one more read of what is already there, then give up
             self._read(max(0.0, min(remaining, 0.05)))
 
-    def expect(self, pattern: str, *, stream: str = "out", timeout: float = 10.0) -> Any:
+    def expect(self, pattern: str, *, stream: str = "out", timeout: float = 30.0) -> Any:
         """Like :meth:`wait_for` but fail the test with the child's output when missing."""
         match = self.wait_for(pattern, stream=stream, timeout=timeout)
         if match is None:
@@ -66,7 +66,7 @@ class Child(ChildOutput):
 
     # --- ending ----------------------------------------------------------------------------
 
-    def finish(self, timeout: float = 10.0) -> tuple[str, str]:
+    def finish(self, timeout: float = 30.0) -> tuple[str, str]:
         """Wait (bounded) for the child to exit on its own; Ctrl-C it if it does not."""
         deadline = time.monotonic() + timeout
         while self._open and (remaining := deadline - time.monotonic()) > 0:

@@ -39,13 +39,13 @@ def test_a_raising_callback_is_logged_with_the_node_name_and_the_node_keeps_spin
     assert spin_until(
         node,
         lambda: child.wait_for(pattern, stream="err", timeout=0.0) is not None,
-        8.0,
+        20.0,
         each=lambda: pub.publish(Int32(data=0)),
     ), child.text
     assert spin_until(
         node,
         lambda: child.wait_for("^got 25$", timeout=0.0) is not None,
-        8.0,
+        20.0,
         each=lambda: pub.publish(Int32(data=4)),
     ), child.text
     assert child.popen.poll() is None
@@ -123,7 +123,7 @@ def test_with_callback_errors_raise_a_subscription_error_stops_spin_in_a_script(
     assert spin_until(
         node,
         lambda: child.wait_for("^spin raised ZeroDivisionError$", timeout=0.0) is not None,
-        8.0,
+        20.0,
         each=lambda: pub.publish(Int32(data=0)),
     ), child.text
     child.finish()

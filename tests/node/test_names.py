@@ -88,12 +88,12 @@ def test_command_line_remaps_rename_the_node_its_namespace_and_its_topics(ros, s
     )
     node.create_subscription(String, "/chatter", lambda m: got.update(chatter=m.data), 10)
 
-    assert spin_until(node, lambda: {"other", "status"} <= set(got), 8.0), got
+    assert spin_until(node, lambda: {"other", "status"} <= set(got), 20.0), got
     assert got["other"] == "on chatter"
     assert got["status"] == "on status"
     assert "chatter" not in got
     assert spin_until(
-        node, lambda: ("renamed", "/robot1") in node.get_node_names_and_namespaces(), 5.0
+        node, lambda: ("renamed", "/robot1") in node.get_node_names_and_namespaces(), 15.0
     )
     assert ("talker", "/") not in node.get_node_names_and_namespaces()
 

@@ -38,7 +38,9 @@ def test_a_string_crosses_to_another_process_and_its_echo_comes_back(ros, spawn)
     node.create_subscription(String, "pong", lambda m: replies.append(m.data), 10)
     text = "hello wörld ✓ 123"
 
-    assert spin_until(node, lambda: bool(replies), 8.0, each=lambda: pub.publish(String(data=text)))
+    assert spin_until(
+        node, lambda: bool(replies), 20.0, each=lambda: pub.publish(String(data=text))
+    )
     assert replies[0] == f"echo {text}"
     child.expect(f"^heard: {text}$")
 
@@ -91,7 +93,7 @@ def test_a_laser_scan_with_arrays_and_a_nested_twist_arrive_with_equal_values(ro
     node.create_subscription(LaserScan, "scan", scans.append, 10)
     node.create_subscription(Twist, "/cmd_vel", twists.append, 10)
 
-    assert spin_until(node, lambda: bool(scans) and bool(twists), 8.0)
+    assert spin_until(node, lambda: bool(scans) and bool(twists), 20.0)
     scan = scans[0]
     assert scan.header.frame_id == "laser_frame"
     assert (scan.header.stamp.sec, scan.header.stamp.nanosec) == (12, 345)
@@ -175,7 +177,7 @@ def _late_subscriber(ros, spawn, durability):
     qos = QoSProfile(depth=10, durability=durability)
     node.create_subscription(Int32, "latched", lambda m: got.append(m.data), qos)
     # wait for the live message 6 (sent ~0.5 s after the subscription is seen), then a bit more
-    assert spin_until(node, lambda: 6 in got, 8.0), f"no live message arrived: {got}"
+    assert spin_until(node, lambda: 6 in got, 20.0), f"no live message arrived: {got}"
     spin_for(node, 0.2)
     return got
 
@@ -306,7 +308,7 @@ def test_a_message_of_another_type_is_dropped_with_one_warning_and_never_misdeco
     got: list[str] = []
     sub = node.create_subscription(String, "mixed", lambda m: got.append(m.data), 10)
 
-    assert spin_until(node, lambda: sub.mismatched >= 3, 8.0)
+    assert spin_until(node, lambda: sub.mismatched >= 3, 20.0)
     assert got == []
     err = capfd.readouterr().err
     warnings = re.findall(

@@ -81,12 +81,12 @@ def test_an_unmodified_rclpy_script_talks_to_a_rosl_node(ros, spawn, tmp_path):
     node.create_subscription(String, "chatter", lambda m: heard.append(m.data), 10)
     reply = node.create_publisher(String, "reply", 10)
 
-    assert spin_until(node, lambda: bool(heard), 8.0)
+    assert spin_until(node, lambda: bool(heard), 20.0)
     assert heard[0].startswith("bonjour ")
     assert spin_until(
         node,
         lambda: child.wait_for("^reply: from rosl$", timeout=0.0) is not None,
-        8.0,
+        20.0,
         each=lambda: reply.publish(String(data="from rosl")),
     )
     child.expect(r"\[INFO\] \[\d+\.\d{9}\] \[rclpy_talker\]: I heard: from rosl", stream="err")
@@ -230,7 +230,7 @@ def test_an_rclpy_script_with_its_own_executor_publishes_and_stops_on_ctrl_c(ros
     node = ros.Node("count_listener")
     got: list[int] = []
     node.create_subscription(Int32, "count", lambda m: got.append(m.data), 10)
-    assert spin_until(node, lambda: len(got) >= 3, 8.0)
+    assert spin_until(node, lambda: len(got) >= 3, 20.0)
     assert got == sorted(got)
 
     child.popen.send_signal(signal.SIGINT)

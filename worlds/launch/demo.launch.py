@@ -35,6 +35,7 @@ def generate_launch_description():
                         "use_sim_time": True,
                         "distance_threshold": 0.5,  # the Burger is 0.2 m wide; its arena is small
                         "field_of_view": 1.2,  # look +-34 degrees ahead, not all around
+                        "linear_speed": 0.22,  # the Burger's top speed (the tutorial's 0.3 is not)
                     }
                 ],
             ),

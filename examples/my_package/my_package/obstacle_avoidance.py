@@ -4,9 +4,10 @@ Reads a LaserScan on `laser_scan`, takes the minimum range, and publishes a Twis
 `cmd_vel`: turn in place (0.3 rad/s) when something is closer than 1 m, else drive straight
 (0.3 m/s). The launch file remaps both names to Dolly's /dolly/laser_scan and /dolly/cmd_vel.
 
-Two parameters (not in the tutorial) let the same node drive a TurtleBot3, whose LiDAR sees
-all around and whose arena is small: `distance_threshold` (default 1.0 m) and
-`field_of_view` (radians around straight ahead; default 0: every reading, as the tutorial).
+Parameters not in the tutorial let the same node drive a TurtleBot3, whose LiDAR sees all
+around, whose arena is small and whose top speed is 0.22 m/s: `distance_threshold` (default
+1.0 m), `field_of_view` (radians around straight ahead; default 0: every reading, as the
+tutorial), `linear_speed` and `angular_speed` (defaults 0.3 m/s and 0.3 rad/s, as the tutorial).
 """
 
 import math
@@ -23,6 +24,8 @@ class ObstacleAvoidance(Node):
         super().__init__("ObstacleAvoidance")
         self.threshold = self.declare_parameter("distance_threshold", 1.0).value
         self.field_of_view = self.declare_parameter("field_of_view", 0.0).value
+        self.linear_speed = self.declare_parameter("linear_speed", 0.3).value
+        self.angular_speed = self.declare_parameter("angular_speed", 0.3).value
         self.subscription = self.create_subscription(
             LaserScan, "laser_scan", self.topic_callback, qos_profile_system_default
         )
@@ -46,9 +49,9 @@ class ObstacleAvoidance(Node):
         self.get_logger().info(f"Distance is: '{distance:f}'")
         if distance < self.threshold:
             msg.linear.x = 0.0  # turn around
-            msg.angular.z = 0.3
+            msg.angular.z = self.angular_speed
         else:
-            msg.linear.x = 0.3  # go straight ahead
+            msg.linear.x = self.linear_speed  # go straight ahead
             msg.angular.z = 0.0
         return msg
 

@@ -1,6 +1,9 @@
 """rclpy.exceptions."""
 
 from rosl.node.errors import (
+    InvalidNameError as InvalidTopicNameException,
+)
+from rosl.node.errors import (
     InvalidParameterTypeException,
     InvalidParameterValueException,
     ParameterAlreadyDeclaredException,
@@ -9,7 +12,6 @@ from rosl.node.errors import (
 from rosl.node.errors import (
     NotInitializedError as NotInitializedException,
 )
-from rosl.node.names import InvalidNameError as InvalidTopicNameException
 
 __all__ = [
     "InvalidParameterTypeException",
