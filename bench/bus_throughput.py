@@ -14,7 +14,6 @@ loss there must be 0.
 from __future__ import annotations
 
 import argparse
-import selectors
 import sys
 import time
 
@@ -56,27 +55,23 @@ def pub_raw(count: int, size: int) -> None:
 
 def sub_bus(count: int, size: int) -> None:
     from rosl.bus.header import topic_hash
-    from rosl.bus.multicast import Addressing
-    from rosl.bus.transport import MulticastTransport, channel_of
-    from rosl.bus.wire import Reader
+    from rosl.bus.multicast import Addressing, MulticastTransport
+    from rosl.bus.transport import channel_of
 
     transport = MulticastTransport(Addressing(BENCH_DOMAIN))
-    reader = Reader()
+    receiver = transport.receiver()  # the seam's receive loop, as nodes use it
+    reader = receiver.reader
     topic = topic_hash("/bench")
     reader.wanted.add(topic)
-    sock = transport.open(channel_of(topic))
-    selector = selectors.DefaultSelector()
-    selector.register(sock, selectors.EVENT_READ)
+    receiver.join(channel_of(topic))
     print("ready", flush=True)
     out: list = []
     got = 0
     first = last = 0.0
     idle_since = time.perf_counter()
     while got < count and time.perf_counter() - idle_since < 1.0:
-        if not selector.select(0.2):
-            continue
         out.clear()
-        reader.drain(sock, out)
+        receiver.poll(0.2, out)
         if out:
             last = time.perf_counter()
             idle_since = last
@@ -88,8 +83,7 @@ def sub_bus(count: int, size: int) -> None:
 
 def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) -> None:
     from rosl.bus.coalesce import DEFAULT_BYTES, Flusher
-    from rosl.bus.multicast import Addressing
-    from rosl.bus.transport import MulticastTransport
+    from rosl.bus.multicast import Addressing, MulticastTransport
     from rosl.bus.wire import Writer
 
     transport = MulticastTransport(Addressing(BENCH_DOMAIN))

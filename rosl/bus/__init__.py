@@ -1,8 +1,11 @@
-"""The bus: UDP multicast datagrams between the processes of one domain.
+"""The bus: datagrams between the processes of one domain, behind one transport seam.
 
 Owns sockets, the datagram header, fragmentation and reassembly, the domain's addressing
 (which group and port each channel uses) and loss counting. It knows nothing of nodes,
 message types or the graph; payloads are opaque bytes. Imports only ``rosl.errors``.
+``transport.py`` is the seam node/ and graph/ use (send, receivers that join channels and
+poll whole deliveries, wake-ups); ``multicast.py`` is the default transport and
+``inprocess.py`` a one-process transport for tests.
 
 How topics map to the network (documented here because users and tools rely on it):
 

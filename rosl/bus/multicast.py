@@ -1,23 +1,39 @@
-"""Domain → groups and port, and the UDP multicast sockets (loopback, TTL 0, by default).
+"""The UDP multicast transport: domain → groups and port, its sockets and receive loop.
 
-See the package docstring for the address plan. Receive buffers are enlarged to 8 MiB where
-the OS allows; when it grants less than 1 MiB a single warning line says how to raise it.
+Traffic leaves through 127.0.0.1 with TTL 0 by default. See the package docstring for the
+address plan, and :mod:`rosl.bus.transport` for the seam this implements. Receive buffers are
+enlarged to 8 MiB where the OS allows; when it grants less than 1 MiB a single warning line
+says how to raise it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import ipaddress
 import os
+import select
 import socket
 import struct
 import sys
+import threading
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from rosl.bus.errors import BusError
+from rosl.bus.pacing import pacer_from_env
+from rosl.bus.transport import CHANNELS
+from rosl.bus.wire import Reader
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from rosl.bus.transport import Buffer
+    from rosl.bus.wire import Delivery
+
+__all__ = ["CHANNELS", "Addressing", "MulticastReceiver", "MulticastTransport"]
 
 BASE_PORT = 17400
-CHANNELS = 64  # data channels per domain; channel 0 is discovery
 MAX_DOMAIN = 232
 RCVBUF_WANTED = 8 * 1024 * 1024
 RCVBUF_WARN_BELOW = 1024 * 1024
@@ -173,3 +189,146 @@ def _check_rcvbuf(sock: socket.socket) -> None:
             f"messages. Raise it: sudo sysctl -w net.core.rmem_max={RCVBUF_WANTED}",
             file=sys.stderr,
         )
+
+
+class MulticastTransport:
+    """UDP multicast on one domain: one sending socket, receivers with sockets of their own."""
+
+    def __init__(self, addressing: Addressing) -> None:
+        self.addressing = addressing
+        self.name = "multicast"
+        self.fix_hint = FIX_HINT
+        self.domain = addressing.domain
+        self.max_datagram = addressing.max_datagram
+        self.pacer = pacer_from_env(addressing.interface == LOOPBACK)
+        self._sender = open_sender(addressing)
+        self._targets = [(addressing.group(c), addressing.port) for c in range(CHANNELS + 1)]
+        self._receivers: list[MulticastReceiver] = []
+        self._raw: dict[int, socket.socket] = {}
+        self._lock = threading.Lock()
+        self.send_errors = 0
+
+    def send(self, channel: int, parts: Sequence[Buffer]) -> None:
+        """Send one datagram; a full kernel buffer drops it (counted), never blocks."""
+        target = self._targets[channel]
+        try:
+            if len(parts) == 1:
+                self._sender.sendto(parts[0], target)
+            else:
+                self._sender.sendmsg(parts, (), 0, target)
+        except (BlockingIOError, InterruptedError):
+            self.send_errors += 1
+        except OSError as err:
+            if self._sender.fileno() < 0:
+                return  # closed during shutdown
+            raise BusError(
+                f"cannot send to {target[0]}:{target[1]} ({err.strerror}); {FIX_HINT}"
+            ) from None
+
+    def receiver(self) -> MulticastReceiver:
+        """A new receiver (its sockets are opened as it joins channels)."""
+        receiver = MulticastReceiver(self.addressing)
+        with self._lock:
+            self._receivers.append(receiver)
+        return receiver
+
+    def open(self, channel: int) -> socket.socket:
+        """The transport's own raw socket of a channel, opened once (tools read datagrams)."""
+        with self._lock:
+            sock = self._raw.get(channel)
+            if sock is None:
+                sock = self._raw[channel] = open_receiver(self.addressing, channel)
+            return sock
+
+    def describe(self) -> str:
+        """The discovery group and port, and the interface they use."""
+        where = self.addressing
+        return f"{where.group(0)}:{where.port} via {where.interface}"
+
+    def close(self) -> None:
+        """Close every receiver and the sender (idempotent)."""
+        with self._lock:
+            receivers, self._receivers = self._receivers, []
+            raw, self._raw = list(self._raw.values()), {}
+        for receiver in receivers:
+            receiver.close()
+        for sock in raw:
+            sock.close()
+        self._sender.close()
+
+
+class MulticastReceiver:
+    """Channel sockets read with ``select``, woken through a pipe."""
+
+    def __init__(self, addressing: Addressing) -> None:
+        self.addressing = addressing
+        self.reader = Reader()
+        self._sockets: dict[int, socket.socket] = {}
+        self._lock = threading.Lock()
+        self._wake_read, self._wake_write = os.pipe()
+        os.set_blocking(self._wake_read, False)
+        os.set_blocking(self._wake_write, False)
+        self._closed = False
+
+    def join(self, channel: int) -> None:
+        """Open the channel's socket (joining its group) unless it is open."""
+        with self._lock:
+            if channel not in self._sockets and not self._closed:
+                self._sockets[channel] = open_receiver(self.addressing, channel)
+
+    def leave(self, channel: int) -> None:
+        """Close the channel's socket (leaving its group)."""
+        with self._lock:
+            sock = self._sockets.pop(channel, None)
+        if sock is not None:
+            sock.close()
+
+    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
+        """Wait for datagrams (or a wake-up) and append the complete messages to ``out``."""
+        with self._lock:
+            if self._closed:
+                return 0
+            if channel is None:
+                watched: list[socket.socket | int] = [*self._sockets.values(), self._wake_read]
+            else:
+                sock = self._sockets.get(channel)
+                watched = [] if sock is None else [sock]
+        if not watched:
+            return 0
+        try:
+            ready, _, _ = select.select(
+                watched, [], [], None if timeout is None else max(0.0, timeout)
+            )
+        except (OSError, ValueError):
+            return 0  # a socket closed under us (shutdown)
+        drained = 0
+        drain = self.reader.drain
+        for item in ready:
+            if isinstance(item, socket.socket):
+                drained += 1
+                while drain(item.recv, out):
+                    pass
+            else:
+                with contextlib.suppress(OSError):
+                    while os.read(self._wake_read, 4096):
+                        pass
+        return drained
+
+    def wake(self) -> None:
+        """Wake a thread blocked in :meth:`poll`."""
+        with contextlib.suppress(OSError):
+            os.write(self._wake_write, b"x")
+
+    def close(self) -> None:
+        """Close every socket and the wake-up pipe (idempotent)."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            sockets, self._sockets = list(self._sockets.values()), {}
+        self.wake()
+        for sock in sockets:
+            sock.close()
+        for fd in (self._wake_read, self._wake_write):
+            with contextlib.suppress(OSError):
+                os.close(fd)

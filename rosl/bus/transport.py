@@ -1,94 +1,107 @@
-"""The transport seam: send a datagram on a channel, open a channel to receive.
+"""The transport seam: what node/ and graph/ need from a bus, and which bus a process gets.
 
-Node, graph and bag code only talk to a :class:`Transport`. Multicast is the one built now;
-a Zenoh-backed transport for reaching past one LAN would implement the same three calls.
+A :class:`Transport` sends datagrams on numbered channels and makes :class:`Receiver` s. A
+receiver joins and leaves channels and owns its receive loop: ``poll`` waits (bounded by its
+timeout, cut short by ``wake``) and returns whole :class:`~rosl.bus.wire.Delivery` records —
+reassembly, early filtering and loss accounting happen inside, in the receiver's
+:class:`~rosl.bus.wire.Reader`. Nothing above bus/ sees a socket, a file descriptor or
+``select``. Channel 0 carries discovery; a topic or service travels on
+:func:`channel_of` its hash.
+
+Implementations: :class:`rosl.bus.multicast.MulticastTransport` (UDP multicast, the default)
+and :class:`rosl.bus.inprocess.InProcessTransport` (one process, for tests of the seam). The
+environment variable ``ROSL_TRANSPORT`` picks one (``multicast``, ``inprocess``).
 """
 
 from __future__ import annotations
 
-import threading
+import os
 from typing import TYPE_CHECKING, Protocol
 
-from rosl.bus import multicast
 from rosl.bus.errors import BusError
-from rosl.bus.pacing import Pacer, pacer_from_env
 
 if TYPE_CHECKING:
-    import socket
     from collections.abc import Sequence
 
-    from rosl.bus.multicast import Addressing
+    from rosl.bus.pacing import Pacer
+    from rosl.bus.wire import Delivery, Reader
 
 Buffer = bytes | bytearray | memoryview
+CHANNELS = 64  # data channels per domain (1..CHANNELS); channel 0 is discovery
+TRANSPORTS = ("multicast", "inprocess")
+
+
+class Receiver(Protocol):
+    """One receive loop: the channels it joined, whole deliveries out."""
+
+    reader: Reader  # reassembly, topic filter, per-publisher sequence and loss counts
+
+    def join(self, channel: int) -> None:
+        """Start receiving ``channel`` (idempotent)."""
+
+    def leave(self, channel: int) -> None:
+        """Stop receiving ``channel`` (idempotent)."""
+
+    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
+        """Wait up to ``timeout`` seconds, then append every complete message to ``out``.
+
+        Args:
+            timeout: seconds to wait for a first datagram (None: until one or a wake-up).
+            out: receives the deliveries, in arrival order per channel.
+            channel: read only this channel, and do not take wake-ups (a nested wait).
+
+        Returns:
+            How many channels had datagrams (callers sort across channels when > 1).
+        """
+
+    def wake(self) -> None:
+        """Make a blocked (or the next) :meth:`poll` return at once."""
+
+    def close(self) -> None:
+        """Leave every channel; a later poll returns nothing (idempotent)."""
 
 
 class Transport(Protocol):
-    """What the rest of rosl needs from a transport."""
+    """A bus for one domain: send on channels, receive through receivers."""
 
-    addressing: Addressing
-    max_datagram: int
-    pacer: Pacer
+    name: str  # for messages to the user: "multicast"
+    fix_hint: str  # what to check when a process never hears its own datagrams
+    domain: int
+    max_datagram: int  # the largest datagram send() takes, header included
+    pacer: Pacer  # paces fragmented messages so receivers keep up
 
     def send(self, channel: int, parts: Sequence[Buffer]) -> None:
         """Send one datagram made of ``parts`` to every receiver of ``channel``."""
 
-    def open(self, channel: int) -> socket.socket:
-        """Return a non-blocking socket receiving ``channel`` (shared, opened once)."""
+    def receiver(self) -> Receiver:
+        """A new receiver with no channel joined."""
+
+    def describe(self) -> str:
+        """Where the traffic goes, for messages (``239.255.5.0:17405 via 127.0.0.1``)."""
 
     def close(self) -> None:
-        """Close every socket."""
-
-
-class MulticastTransport:
-    """UDP multicast on one domain; sockets are opened lazily and shared in the process."""
-
-    def __init__(self, addressing: Addressing) -> None:
-        self.addressing = addressing
-        self.max_datagram = addressing.max_datagram
-        self.pacer = pacer_from_env(addressing.interface == multicast.LOOPBACK)
-        self._sender = multicast.open_sender(addressing)
-        self._targets = [
-            (addressing.group(c), addressing.port) for c in range(multicast.CHANNELS + 1)
-        ]
-        self._receivers: dict[int, socket.socket] = {}
-        self._lock = threading.Lock()
-        self.send_errors = 0
-
-    def send(self, channel: int, parts: Sequence[Buffer]) -> None:
-        """Send one datagram; a full kernel buffer drops it (counted), never blocks."""
-        target = self._targets[channel]
-        try:
-            if len(parts) == 1:
-                self._sender.sendto(parts[0], target)
-            else:
-                self._sender.sendmsg(parts, (), 0, target)
-        except (BlockingIOError, InterruptedError):
-            self.send_errors += 1
-        except OSError as err:
-            if self._sender.fileno() < 0:
-                return  # closed during shutdown
-            raise BusError(
-                f"cannot send to {target[0]}:{target[1]} ({err.strerror}); {multicast.FIX_HINT}"
-            ) from None
-
-    def open(self, channel: int) -> socket.socket:
-        """Return the receiving socket of a channel, joining its group the first time."""
-        with self._lock:
-            sock = self._receivers.get(channel)
-            if sock is None:
-                sock = multicast.open_receiver(self.addressing, channel)
-                self._receivers[channel] = sock
-            return sock
-
-    def close(self) -> None:
-        """Close every socket (idempotent)."""
-        with self._lock:
-            for sock in self._receivers.values():
-                sock.close()
-            self._receivers.clear()
-            self._sender.close()
+        """Close the sender and every receiver (idempotent)."""
 
 
 def channel_of(topic_hash: int) -> int:
     """The data channel (1..CHANNELS) a topic or service hash travels on."""
-    return 1 + topic_hash % multicast.CHANNELS
+    return 1 + topic_hash % CHANNELS
+
+
+def open_transport(domain: int | str | None = None) -> Transport:
+    """The transport ``ROSL_TRANSPORT`` names (multicast by default) on a domain.
+
+    Raises:
+        BusError: an unknown transport name, a bad domain id, or a bus that cannot be opened.
+    """
+    name = os.environ.get("ROSL_TRANSPORT", "").strip().lower() or "multicast"
+    if name == "multicast":
+        from rosl.bus.multicast import MulticastTransport, addressing_from_env
+
+        return MulticastTransport(addressing_from_env(domain))
+    if name == "inprocess":
+        from rosl.bus.inprocess import InProcessTransport
+        from rosl.bus.multicast import domain_from_env
+
+        return InProcessTransport(domain_from_env(domain))
+    raise BusError(f"ROSL_TRANSPORT={name!r} is not a transport (one of: {', '.join(TRANSPORTS)})")

@@ -1,10 +1,10 @@
 """Messages ↔ datagrams: headers, sequence numbers, fragments, early filtering, loss counts.
 
 A :class:`Writer` sends the messages of one endpoint (a publisher, a service client or
-server). A :class:`Reader` drains channel sockets: foreign datagrams and topics nobody in the
-process wants are dropped after the header is read, fragments are reassembled, and each
-publisher stream's sequence numbers are checked so every gap is counted — loss is never
-silent. Callbacks run on the thread that reads the socket; nothing is handed off.
+server). A :class:`Reader` turns a receiver's datagrams into deliveries: foreign datagrams and
+topics nobody in the process wants are dropped after the header is read, fragments are
+reassembled, and each publisher stream's sequence numbers are checked so every gap is counted
+— loss is never silent. Callbacks run on the thread that polls; nothing is handed off.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from rosl.bus.transport import channel_of
 
 if TYPE_CHECKING:
     import mmap
-    import socket
+    from collections.abc import Callable
 
     from rosl.bus.coalesce import Flusher
     from rosl.bus.transport import Buffer, Transport
@@ -167,7 +167,7 @@ class Writer:
 
 
 class Reader:
-    """Turns the datagrams of channel sockets into complete :class:`Delivery` records."""
+    """Turns a receiver's datagrams into complete :class:`Delivery` records."""
 
     def __init__(self) -> None:
         self.wanted: set[int] = set()  # topic hashes someone in this process listens to
@@ -179,17 +179,18 @@ class Reader:
         self.reassembler = Reassembler()
         self._next_expiry = 0
 
-    def drain(self, sock: socket.socket, out: list[Delivery], limit: int = 256) -> bool:
-        """Read up to ``limit`` ready datagrams from ``sock`` into ``out``.
+    def drain(self, recv: Callable[[int], bytes], out: list[Delivery], limit: int = 256) -> bool:
+        """Read up to ``limit`` ready datagrams with ``recv`` into ``out``.
 
-        Each datagram is received into its own buffer, so payloads are zero-copy views that
-        stay valid after the next read.
+        ``recv(size)`` returns the next datagram and raises BlockingIOError when there is
+        none (a non-blocking socket's ``recv``). Each datagram is its own buffer, so payloads
+        are zero-copy views that stay valid after the next read.
 
         Returns:
-            True when the socket may hold more (the limit was reached).
+            True when the source may hold more (the limit was reached).
         """
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
-        recv, clock, streams = sock.recv, time.time_ns, self.streams
+        clock, streams = time.time_ns, self.streams
         if self.reassembler.pending:  # drop (and count) messages whose fragments stopped coming
             now = clock()
             if now >= self._next_expiry:

@@ -14,12 +14,10 @@ CLI waits exactly as long as the graph needs, with a bound for processes that di
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import json
 import os
-import select
-import socket
+import platform
 import sys
 import threading
 import time
@@ -28,8 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 from rosl.bus.errors import BusError
 from rosl.bus.header import Kind
-from rosl.bus.multicast import FIX_HINT
-from rosl.bus.wire import Delivery, Reader, Writer
+from rosl.bus.wire import Delivery, Writer
 from rosl.graph.cache import GraphCache
 from rosl.graph.records import ProcessRecord, from_json, to_json
 
@@ -43,7 +40,7 @@ DISCOVERY_TOPIC = "@discovery"
 DISCOVERY_TYPE = "rosl/discovery/1"
 PERIOD_S = 1.0
 SELFTEST_S = 2.0
-HOST = socket.gethostname()
+HOST = platform.node()
 
 
 @dataclass(slots=True)
@@ -75,12 +72,10 @@ class Discovery:
         self._writer = Writer(
             transport, sender, 0, DISCOVERY_TOPIC, DISCOVERY_TYPE, Kind.DISCOVERY, channel=0
         )
-        self._reader = Reader()
+        self._receiver = transport.receiver()
+        self._reader = self._receiver.reader
         self._reader.wanted.add(self._writer.topic)
-        self._socket = transport.open(0)
-        self._wake_read, self._wake_write = os.pipe()
-        os.set_blocking(self._wake_read, False)
-        os.set_blocking(self._wake_write, False)
+        self._receiver.join(0)
         self._version = itertools.count(1)
         self._query_ids = itertools.count(1)
         self._queries: dict[int, _Query] = {}
@@ -111,9 +106,7 @@ class Discovery:
             self._thread.join(timeout=2.0)
         # last, so no announcement still being made can overtake the goodbye
         self._send({"op": "bye", "sender": f"{self.sender:016x}"})
-        for fd in (self._wake_read, self._wake_write):
-            with contextlib.suppress(OSError):
-                os.close(fd)
+        self._receiver.close()
 
     def changed(self) -> None:
         """Local nodes changed: announce them now."""
@@ -121,8 +114,7 @@ class Discovery:
         self._wake()
 
     def _wake(self) -> None:
-        with contextlib.suppress(OSError):
-            os.write(self._wake_write, b"x")
+        self._receiver.wake()
 
     # --- queries -----------------------------------------------------------------------------
 
@@ -170,10 +162,10 @@ class Discovery:
 
     def selftest_message(self) -> str:
         """The one-line explanation when our own datagrams do not come back."""
-        where = self._transport.addressing
+        transport = self._transport
         return (
-            f"multicast does not work here: this process never received its own datagram on "
-            f"{where.group(0)}:{where.port} via {where.interface}; {FIX_HINT}"
+            f"{transport.name} does not work here: this process never received its own "
+            f"datagram on {transport.describe()}; {transport.fix_hint}"
         )
 
     def send(self, message: dict[str, Any]) -> None:
@@ -220,23 +212,10 @@ class Discovery:
             self.cache.expire(now)
             self._check_selftest(now)
             wait = max(0.0, min(self._announce_due - time.monotonic(), 0.5))
-            try:
-                watched: list[socket.socket | int] = [self._socket, self._wake_read]
-                ready, _, _ = select.select(watched, [], [], wait)
-            except (OSError, ValueError):
-                return  # closed during shutdown
-            if self._wake_read in ready:
-                try:
-                    while os.read(self._wake_read, 512):
-                        pass
-                except OSError:
-                    pass
-            if self._socket in ready:
-                deliveries.clear()
-                while self._reader.drain(self._socket, deliveries):
-                    pass
-                for delivery in deliveries:
-                    self._handle(delivery)
+            deliveries.clear()
+            self._receiver.poll(wait, deliveries)
+            for delivery in deliveries:
+                self._handle(delivery)
 
     def _check_selftest(self, now: float) -> None:
         if self.loopback_ok.is_set() or self._warned or now - self._started < SELFTEST_S:

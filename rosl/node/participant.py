@@ -1,31 +1,28 @@
 """This process on the bus: transport, discovery, endpoint numbers, and dispatch.
 
 One participant per process (created with the first node, or by a CLI that only observes).
-Its channel sockets are read on the thread that spins — deliveries go straight to the
-endpoint's handler, with no thread hand-off. The discovery thread answers graph queries even
-while the user's callbacks run.
+It reaches the network only through the transport seam (:mod:`rosl.bus.transport`): its
+receiver is polled on the thread that spins — deliveries go straight to the endpoint's
+handler, with no thread hand-off. The discovery thread answers graph queries even while the
+user's callbacks run.
 """
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import os
-import select
-import socket
 import threading
 from typing import TYPE_CHECKING, Protocol, cast
 
 from rosl.bus.header import Flags, topic_hash
-from rosl.bus.multicast import addressing_from_env
-from rosl.bus.transport import MulticastTransport, channel_of
-from rosl.bus.wire import Delivery, Reader, Writer
+from rosl.bus.transport import CHANNELS, channel_of, open_transport
 from rosl.graph.announce import Discovery
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from rosl.bus.coalesce import Flusher
+    from rosl.bus.wire import Delivery, Writer
     from rosl.graph.cache import GraphCache
     from rosl.graph.records import NodeRecord
     from rosl.node.lockstep import Answerer
@@ -49,19 +46,16 @@ class Participant:
     """The process's presence on one domain."""
 
     def __init__(self, domain: int | str | None = None) -> None:
-        self.transport = MulticastTransport(addressing_from_env(domain))
+        self.transport = open_transport(domain)
         self.sender = int.from_bytes(os.urandom(8), "little") | 1
-        self.reader = Reader()
+        self._receiver = self.transport.receiver()
+        self.reader = self._receiver.reader
         self._endpoint_ids = itertools.count(1)
         self._node_ids = itertools.count(1)
         self._describers: dict[int, Callable[[], NodeRecord]] = {}
         self._handlers: dict[int, list[Handler]] = {}
-        self._sockets: dict[int, socket.socket] = {}
         self._deferred: list[Delivery] = []
         self._lock = threading.RLock()
-        self._wake_read, self._wake_write = os.pipe()
-        os.set_blocking(self._wake_read, False)
-        os.set_blocking(self._wake_write, False)
         self._replayers: dict[str, list[Replayer]] = {}
         self.writers: list[Writer] = []  # the publishers' writers (lock-step answers list them)
         self.answerer: Answerer | None = None  # created when an executor first spins
@@ -142,9 +136,7 @@ class Participant:
         with self._lock:
             self._handlers.setdefault(topic, []).append(handler)
             self.reader.wanted.add(topic)
-            channel = channel_of(topic)
-            if channel not in self._sockets:
-                self._sockets[channel] = self.transport.open(channel)
+        self._receiver.join(channel_of(topic))
         self.wake()
 
     def unlisten(self, topic: int, handler: Handler) -> None:
@@ -160,22 +152,20 @@ class Participant:
 
     def listen_all(self) -> None:
         """Receive every topic on every channel (for recorders and monitors)."""
-        from rosl.bus.multicast import CHANNELS
         from rosl.node.lockstep import TOPIC as LOCKSTEP_TOPIC
 
         with self._lock:
             self.reader.want_all = True
             self.reader.ignored.add(topic_hash(LOCKSTEP_TOPIC))  # lock-step answers: control only
-            for channel in range(1, CHANNELS + 1):
-                if channel not in self._sockets:
-                    self._sockets[channel] = self.transport.open(channel)
+        for channel in range(1, CHANNELS + 1):
+            self._receiver.join(channel)
+        self.wake()
 
     # --- receiving ---------------------------------------------------------------------------
 
     def wake(self) -> None:
         """Wake a thread blocked in :meth:`poll`."""
-        with contextlib.suppress(OSError):
-            os.write(self._wake_write, b"x")
+        self._receiver.wake()
 
     def poll(self, timeout: float | None, sink: Callable[[Delivery], None] | None = None) -> int:
         """Wait up to ``timeout`` for datagrams, then dispatch every complete message.
@@ -190,29 +180,10 @@ class Participant:
         if self.closed:
             return 0
         with self._lock:
-            sockets = list(self._sockets.values())
-            pending, self._deferred = self._deferred, []
-        if pending:
-            timeout = 0.0
-        try:
-            watched: list[socket.socket | int] = [*sockets, self._wake_read]
-            ready, _, _ = select.select(watched, [], [], timeout)
-        except (OSError, ValueError):
-            return 0  # a socket closed under us (shutdown)
-        if self._wake_read in ready:
-            try:
-                while os.read(self._wake_read, 4096):
-                    pass
-            except OSError:
-                pass
-        deliveries = pending
-        drained = 0
-        for sock in ready:
-            if isinstance(sock, socket.socket):  # not the wake-up pipe
-                drained += 1
-                while self.reader.drain(sock, deliveries):
-                    pass
-        if drained > 1 or pending:
+            deliveries, self._deferred = self._deferred, []
+        pending = bool(deliveries)
+        channels = self._receiver.poll(0.0 if pending else timeout, deliveries)
+        if channels > 1 or pending:
             deliveries.sort(key=_send_order)  # in the order they were sent, across channels
         for delivery in deliveries:
             if sink is not None:
@@ -250,18 +221,8 @@ class Participant:
 
         Used by blocking calls (``Client.call``) that must not run other callbacks.
         """
-        with self._lock:
-            sock = self._sockets.get(channel_of(channel_topic))
-        if sock is None:
-            return []
-        try:
-            ready, _, _ = select.select([sock], [], [], max(0.0, timeout))
-        except (OSError, ValueError):
-            return []
         found: list[Delivery] = []
-        if ready:
-            while self.reader.drain(sock, found):
-                pass
+        self._receiver.poll(max(0.0, timeout), found, channel=channel_of(channel_topic))
         return found
 
     def flusher(self) -> Flusher:
@@ -279,7 +240,7 @@ class Participant:
             self._flusher.flush()
 
     def close(self) -> None:
-        """Send pending batches, say goodbye and close every socket (idempotent)."""
+        """Send pending batches, say goodbye and close the transport (idempotent)."""
         if self.closed:
             return
         if self._flusher is not None:
@@ -288,9 +249,6 @@ class Participant:
         self.discovery.stop()
         self.wake()
         self.transport.close()
-        for fd in (self._wake_read, self._wake_write):
-            with contextlib.suppress(OSError):
-                os.close(fd)
 
 
 _LOCKSTEP = int(Flags.LOCKSTEP)  # a plain int: enum operators are slow per message

@@ -363,7 +363,7 @@ class SimNode:
         self._told = {id(w): w.last_seq for w in participant.writers}  # before the recorder
         self.recorder = Recorder(
             folder,
-            domain=self.node.participant.transport.addressing.domain,
+            domain=self.node.participant.transport.domain,
             compression="zstd",
             log=log,
         )

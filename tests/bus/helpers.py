@@ -60,7 +60,7 @@ class Collector:
             ready, _, _ = select.select([self.sock], [], [], 0.02)
             if not ready:
                 continue
-            while self.reader.drain(self.sock, batch):
+            while self.reader.drain(self.sock.recv, batch):
                 pass
             with self._lock:
                 self.deliveries.extend(batch)

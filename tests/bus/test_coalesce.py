@@ -10,8 +10,7 @@ import pytest
 
 from rosl.bus.coalesce import RECORD, Flusher, split_records
 from rosl.bus.header import HEADER, HEADER_SIZE, MAGIC, VERSION, Flags, Kind, topic_hash
-from rosl.bus.multicast import Addressing
-from rosl.bus.transport import MulticastTransport
+from rosl.bus.multicast import Addressing, MulticastTransport
 from tests.bus.test_wire import ENDPOINT, SENDER, TOPIC, Bus, payload_of
 
 if TYPE_CHECKING:

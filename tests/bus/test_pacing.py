@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from rosl.bus import pacing
+from rosl.bus.multicast import MulticastTransport
 from rosl.bus.pacing import DEFAULT_BURST, DEFAULT_RATE, Pacer, pacer_from_env
-from rosl.bus.transport import MulticastTransport
 
 
 class FakeClock:

@@ -18,11 +18,12 @@ from rosl.bus.header import ADDRESS, HEADER, HEADER_SIZE, MAGIC, Flags, Kind, to
 from rosl.bus.multicast import (
     CHANNELS,
     Addressing,
+    MulticastTransport,
     addressing_from_env,
     domain_from_env,
     interface_address,
 )
-from rosl.bus.transport import MulticastTransport, channel_of
+from rosl.bus.transport import channel_of
 from rosl.bus.wire import Reader, Writer
 from rosl.errors import RoslError
 from tests.bus.helpers import Collector, Lines, another_domain, wait_exit
@@ -414,7 +415,8 @@ RECEIVER = r"""
 import hashlib, select, sys, time
 from rosl.bus.header import topic_hash
 from rosl.bus.multicast import Addressing
-from rosl.bus.transport import MulticastTransport, channel_of
+from rosl.bus.multicast import MulticastTransport
+from rosl.bus.transport import channel_of
 from rosl.bus.wire import Reader
 
 domain, topic, want = int(sys.argv[1]), sys.argv[2], int(sys.argv[3])
@@ -433,7 +435,7 @@ while done < want and time.monotonic() < deadline:
     ready, _, _ = select.select([sock], [], [], 0.1)
     if ready:
         heard = time.monotonic()
-        while reader.drain(sock, got):
+        while reader.drain(sock.recv, got):
             pass
         for d in got:  # the sender waits for this line before it sends the next message
             print("msg", d.seq, len(d.payload), hashlib.sha256(d.payload).hexdigest(), flush=True)
@@ -628,13 +630,13 @@ def test_drain_respects_its_limit(bus: Bus) -> None:
     got: list[Delivery] = []
     deadline = time.monotonic() + 5
     while len(got) < 3 and time.monotonic() < deadline:
-        bus.reader.drain(sock, got, limit=3 - len(got))
+        bus.reader.drain(sock.recv, got, limit=3 - len(got))
         time.sleep(0.01)
     assert [bytes(d.payload) for d in got] == [b"n0", b"n1", b"n2"]
     while len(got) < 10 and time.monotonic() < deadline:
-        bus.reader.drain(sock, got)
+        bus.reader.drain(sock.recv, got)
     assert len(got) == 10
-    assert bus.reader.drain(sock, got) is False  # empty now
+    assert bus.reader.drain(sock.recv, got) is False  # empty now
 
 
 def test_unrelated_datagram_on_the_port_to_a_unicast_address_is_ignored(bus: Bus) -> None:
