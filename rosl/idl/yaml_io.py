@@ -120,39 +120,49 @@ def message_to_csv(
     no_str: bool = False,
 ) -> str:
     """Return the comma-separated leaf values ``ros2 topic echo --csv`` prints."""
-
-    def text(value: Any, ftype: FieldType | None) -> str:
-        if isinstance(value, (list, tuple, np.ndarray)):
-            if no_arr and ftype is not None:
-                return _array_placeholder(value, ftype)
-            parts: list[str] = []
-            for index, item in enumerate(value):
-                if truncate_length is not None and index >= truncate_length:
-                    parts.append("...")
-                    break
-                parts.append(text(item, None))
-            return ",".join(parts)
-        if isinstance(value, Message):
-            return message_to_csv(
-                value, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str
-            )
-        if isinstance(value, str):
-            if no_str:
-                return f"<string length: <{len(value)}>>"
-            if truncate_length is not None and len(value) > truncate_length:
-                return value[:truncate_length] + "..."
-        if isinstance(value, bytes):  # a byte field prints as b'2'
-            if truncate_length is not None and len(value) > truncate_length:
-                value = value[:truncate_length] + b"..."
-            return str(value)
-        if isinstance(value, np.generic):
-            value = value.item()
-        return str(value)
-
     return ",".join(
-        text(getattr(message, name), ftype)
+        _csv_text(getattr(message, name), ftype, truncate_length, no_arr, no_str)
         for name, ftype in zip(message._fields, message._field_types, strict=True)
     )
+
+
+def value_to_csv(value: Any, *, truncate_length: int | None = None) -> str:
+    """A field's value (a message, a sequence or a scalar) as ``echo --field F --csv``."""
+    return _csv_text(value, None, truncate_length, False, False)
+
+
+def value_to_plain(value: Any, *, truncate_length: int | None = None) -> Any:
+    """A field's value as YAML data, with byte fields shown as rosidl_runtime_py does."""
+    return _convert(value, None, truncate_length, False, False)
+
+
+def _csv_text(
+    value: Any, ftype: FieldType | None, truncate: int | None, no_arr: bool, no_str: bool
+) -> str:
+    if isinstance(value, (list, tuple, np.ndarray)):
+        if no_arr and ftype is not None:
+            return _array_placeholder(value, ftype)
+        parts: list[str] = []
+        for index, item in enumerate(value):
+            if truncate is not None and index >= truncate:
+                parts.append("...")
+                break
+            parts.append(_csv_text(item, None, truncate, no_arr, no_str))
+        return ",".join(parts)
+    if isinstance(value, Message):
+        return message_to_csv(value, truncate_length=truncate, no_arr=no_arr, no_str=no_str)
+    if isinstance(value, str):
+        if no_str:
+            return f"<string length: <{len(value)}>>"
+        if truncate is not None and len(value) > truncate:
+            return value[:truncate] + "..."
+    if isinstance(value, bytes):  # a byte field prints as b'2'
+        if truncate is not None and len(value) > truncate:
+            value = value[:truncate] + b"..."
+        return str(value)
+    if isinstance(value, np.generic):
+        value = value.item()
+    return str(value)
 
 
 def parse_yaml_mapping(text: str | None, what: str = "values") -> Mapping[str, Any]:

@@ -204,7 +204,13 @@ def run_filter(check: Any, expr: str | None, value: Any) -> bool:
 
 def render(value: Any, options: EchoOptions) -> str:
     """One message (or selected field) as echo prints it: YAML and ``---``, or a CSV line."""
-    from rosl.idl.yaml_io import dump_yaml, message_to_csv, message_to_yaml
+    from rosl.idl.yaml_io import (
+        dump_yaml,
+        message_to_csv,
+        message_to_yaml,
+        value_to_csv,
+        value_to_plain,
+    )
 
     truncate = options.truncate_length
     if isinstance(value, Message):
@@ -216,11 +222,13 @@ def render(value: Any, options: EchoOptions) -> str:
             flow_style=options.flow_style,
         )  # fmt: skip
         return text + "---"
+    if options.csv:
+        return value_to_csv(value, truncate_length=truncate)
     if hasattr(value, "tolist"):
         value = value.tolist()
-    if isinstance(value, list):
-        return dump_yaml([_plain(v, truncate) for v in value]).rstrip("\n") + "\n---"
-    return f"{value}\n---"
+    if isinstance(value, list):  # items as in a message's YAML (a byte as its character)
+        return dump_yaml(value_to_plain(value, truncate_length=truncate)).rstrip("\n") + "\n---"
+    return f"{value}\n---"  # a lone primitive prints as Python prints it, as ros2 does
 
 
 def _texts(value: Any, info: dict[str, Any], options: EchoOptions) -> list[str]:
@@ -234,14 +242,6 @@ def _texts(value: Any, info: dict[str, Any], options: EchoOptions) -> list[str]:
     from rosl.idl.yaml_io import dump_yaml
 
     return [dump_yaml(info).rstrip("\n") + "\n---", text]
-
-
-def _plain(value: Any, truncate: int | None) -> Any:
-    from rosl.idl.yaml_io import message_to_ordered
-
-    if isinstance(value, Message):
-        return message_to_ordered(value, truncate_length=truncate)
-    return value
 
 
 def echo(

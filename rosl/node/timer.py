@@ -37,9 +37,12 @@ def seconds_to_period_ns(seconds: float, what: str = "create_timer: timer_period
 
 
 def _checked_ns(nanoseconds: int) -> int:
+    number = isinstance(nanoseconds, int | float) and not isinstance(nanoseconds, bool)
     if (
-        isinstance(nanoseconds, float) and not math.isfinite(nanoseconds)
-    ) or not 0 < nanoseconds <= MAX_PERIOD_NS:
+        not number
+        or (isinstance(nanoseconds, float) and not math.isfinite(nanoseconds))
+        or not 0 < nanoseconds <= MAX_PERIOD_NS
+    ):
         raise TimerPeriodError(
             f"timer_period_ns must be an integer > 0 and at most {MAX_PERIOD_NS}, "
             f"got {nanoseconds!r}"
@@ -74,13 +77,17 @@ class Timer:
         period apart. rcl only swaps the period and keeps the call already scheduled (up to
         one old period away); rescheduling from the last call instead made a call due at once,
         or a few milliseconds before the next one. Neither is what a user changing a rate
-        expects.
+        expects. Setting the period it already has changes nothing (code that re-applies a
+        parameter often must not postpone the timer for ever).
         """
         return self._period_ns
 
     @timer_period_ns.setter
     def timer_period_ns(self, period_ns: int) -> None:
-        self._period_ns = _checked_ns(period_ns)
+        checked = _checked_ns(period_ns)
+        if checked == self._period_ns:
+            return
+        self._period_ns = checked
         self._next_call_ns = self.clock.now_ns() + self._period_ns
         self._rescheduled()
 

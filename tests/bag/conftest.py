@@ -194,8 +194,14 @@ class Listener:
     def spin_while_running(self, child: subprocess.Popen[str], timeout: float = 30.0) -> None:
         """Spin while ``child`` runs, then a little longer for the last datagrams."""
         self.spin_until(lambda: child.poll() is not None, timeout)
-        end = time.monotonic() + 0.2
-        self.spin_until(lambda: time.monotonic() > end, 1.0)
+        # its last datagrams are on this process's sockets already: read until a pass brings
+        # nothing new, for at least 0.2 s and at least one pass however slow the machine is
+        end, bound = time.monotonic() + 0.2, time.monotonic() + 10.0
+        while time.monotonic() < bound:
+            before = len(self.heard)
+            self.rosl.spin_once(self.node, timeout_sec=0.05)
+            if len(self.heard) == before and time.monotonic() > end:
+                break
 
     def on(self, topic: str) -> list[tuple[bytes, int]]:
         """(bytes, send time) heard on one topic, in order."""

@@ -275,8 +275,10 @@ def test_play_on_a_terminal_pauses_steps_and_resumes_from_the_keyboard(
     graph = listener.node.participant.graph
     try:
         assert listener.spin_until(lambda: graph.count(PUBLISHER, "/chatter") > 0, timeout=30)
-        end = time.monotonic() + 0.5
-        listener.spin_until(lambda: time.monotonic() > end, 1.0)
+        # unpaused, the first message would go out some 0.3 s after the player announced itself;
+        # 2 s leave room for a loaded machine, so that this can fail when pausing is broken
+        end = time.monotonic() + 2.0
+        listener.spin_until(lambda: time.monotonic() > end, 3.0)
         assert listener.on("/chatter") == []  # paused: nothing flows
         os.write(master, b"\x1b[C")
         assert listener.spin_until(lambda: len(listener.on("/chatter")) == 1, timeout=15)

@@ -90,7 +90,9 @@ def test_frames_prints_the_whole_tree_from_odom_with_static_edges_marked(robot, 
     assert lines[0] == "odom"
     assert lines[1].startswith("  base_footprint  (broadcaster: /odometry, average rate: ")
     assert lines[1].endswith(" Hz)")
-    assert 5.0 < float(lines[1].split("average rate: ")[1].split()[0]) < 100.0
+    # 20 Hz, timed by receive times over 1 s: a loaded machine bunches or spreads them, so
+    # only a wide band (a wrong unit or count leaves it)
+    assert 1.0 < float(lines[1].split("average rate: ")[1].split()[0]) < 1000.0
     assert lines[2] == "    base_link  (broadcaster: /robot_state_publisher, static)"
     assert lines[3:] == [
         f"      {child}  (broadcaster: /robot_state_publisher, static)"

@@ -285,8 +285,8 @@ def test_hz_prints_ros2s_two_line_report_with_the_true_rate(system, processes) -
         assert rate, lines
         measured = float(rate.group(1))
         # published at 20 Hz: a loaded machine delays (and its timer then skips) ticks, and
-        # receive times jitter, so only a wide band; the unit or a wrong count leaves it
-        assert 5.0 < measured < 30.0, lines
+        # bunches receive times, so only a wide band; a wrong unit or count leaves it
+        assert 5.0 < measured < 45.0, lines
         stats = re.fullmatch(
             r"\tmin: (\d+\.\d{3})s max: (\d+\.\d{3})s std dev: \d+\.\d{5}s window: (\d+)",
             stats_line,
@@ -308,8 +308,9 @@ def test_bw_prints_subscribed_then_ros2s_bandwidth_lines(system, processes) -> N
     rate = re.fullmatch(r"(\d+) B/s from (\d+) messages", lines[1])
     assert rate, lines
     # 32 bytes a message (CDR header, int32, float64, string 'reading') at 20 Hz, so about
-    # 640 B/s: a wide band, as a loaded machine delays ticks and receive times jitter
-    assert 32 * 5 < int(rate.group(1)) < 32 * 40, lines
+    # 640 B/s: a wide band, as a loaded machine delays ticks and bunches receive times (the
+    # first report divides by the time since the first message read); bits for bytes leave it
+    assert 32 * 5 < int(rate.group(1)) < 32 * 100, lines
     assert lines[2] == "\tMessage size mean: 32 B min: 32 B max: 32 B"
 
 
@@ -661,6 +662,18 @@ def test_pub_and_echo_of_a_byte_array_use_rclpys_bytes_and_ros2s_yaml(processes)
         "layout:", "  dim: []", "  data_offset: 0", "data:", '- "\\0"', '- "\\x01"', "- ÿ", "---"
     ]  # fmt: skip
     assert echo.interrupt() in (0, None), echo.text("err")
+
+
+def test_echo_field_of_a_byte_array_prints_the_characters_not_base64(processes) -> None:
+    echo = Watched(processes.rosl("topic", "echo", "/field_bytes", "std_msgs/msg/ByteMultiArray",
+                                  "--once", "--field", "data", env={"NO_COLOR": "1"}))  # fmt: skip
+    wait_graph(lambda g: g.count(SUBSCRIPTION, "/field_bytes") == 1)
+    pub = run(processes, "topic", "pub", "--once", "-w", "1", "/field_bytes",
+              "std_msgs/msg/ByteMultiArray", "{data: [65, 66]}")  # fmt: skip
+    assert pub.code == 0, pub
+    assert echo.wait_for("^---$", timeout=30.0), echo.text("err")
+    assert echo.lines() == ["- A", "- B", "---"]  # as in the message's YAML, never !!binary
+    echo.interrupt()
 
 
 def test_echo_says_when_only_some_publishers_are_reliable_as_ros2(system, processes) -> None:

@@ -183,5 +183,5 @@ def test_two_nodes_with_the_same_name_get_a_warning(ros, spawn, capfd):
         seen.append(capfd.readouterr().err)
         return bool(re.search(warning, "".join(seen)))
 
-    assert spin_until(node, warned, 5.0), "".join(seen)
+    assert spin_until(node, warned, 20.0), "".join(seen)
     child.expect(warning, stream="err")

@@ -204,6 +204,33 @@ def test_a_new_period_starts_at_the_change_not_at_the_last_tick(since_last_tick)
     assert ticks == [changed + k * S // 2 for k in range(1, 5)]
 
 
+def test_setting_the_period_it_already_has_keeps_the_schedule():
+    from rosl.node.timer import Timer
+
+    clock = _hand_clock()
+    timer = Timer(None, S // 2, clock)
+    ticks = []
+    now = 0
+    while now < 3 * S:  # code that re-applies its parameter every 0.1 s
+        now += S // 10
+        clock.set_sim_now(now)
+        timer.timer_period_ns = S // 2
+        if timer.is_ready():
+            timer.call()
+            ticks.append(now)
+    assert ticks == [k * S // 2 for k in range(1, 7)]
+
+
+@pytest.mark.parametrize("period", [None, "1s", True, float("nan"), -1])
+def test_a_period_in_ns_that_is_no_positive_number_is_a_timer_period_error(period):
+    from rosl.node.errors import TimerPeriodError
+    from rosl.node.timer import Timer
+
+    timer = Timer(None, S, _hand_clock())
+    with pytest.raises(TimerPeriodError):
+        timer.timer_period_ns = period
+
+
 def test_reset_starts_a_full_period_from_now_and_keeps_the_last_call_time():
     from rosl.node.timer import Timer
 
