@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import importlib
 import os
+import signal
 import sys
+import threading
 from typing import Any
 
 import click
@@ -86,6 +88,7 @@ def cli() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line and return (or exit with) its status."""
+    _take_sigint()
     from rosl.pkg import interrupts
 
     try:
@@ -97,6 +100,7 @@ def main(argv: list[str] | None = None) -> int:
         err.show()
         return _exit(err.exit_code)
     except (click.exceptions.Abort, KeyboardInterrupt):
+        interrupts.caught()  # 130, even if the Ctrl-C landed in a class being built
         return _exit(130)
     except RoslError as err:
         _flush_quietly()
@@ -106,8 +110,27 @@ def main(argv: list[str] | None = None) -> int:
         _silence_stdout()
         return _exit(1)
     code = result if isinstance(result, int) else 0
+    signalled = _signalled()
+    if signalled is not None and code == 0:  # stopped by Ctrl-C (rosl's first one is quiet)
+        code = 128 + signalled
     _flush_quietly()
     return _exit(code)
+
+
+def _take_sigint() -> None:
+    # a shell starts a background job (`rosl topic hz /x &`) with SIGINT ignored: take it
+    # anyway, so that `kill -INT` ends any command as Ctrl-C does
+    if (
+        threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    ):
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def _signalled() -> int | None:
+    """The SIGINT/SIGTERM that ended rosl's context in this command, if one did."""
+    context = sys.modules.get("rosl.node.context")
+    return None if context is None else context.default_context.signalled
 
 
 def _flush_quietly() -> None:

@@ -89,15 +89,22 @@ def launch(
         context = LaunchContext(chosen, arguments)
         context.files.append(path)
         os.environ.setdefault("PYTHONUNBUFFERED", "1")
+        chosen.loading = not chosen.stopping  # a Ctrl-C from here on ends the loading at once
         try:
             description = load_description(path)
             check_required_arguments(description, context, path)
             process(description.entities, context)
+            chosen.loading = False
+        except KeyboardInterrupt:
+            if not chosen.interrupted_while_loading:
+                raise
         except BaseException:
+            chosen.loading = False
             chosen.shutdown("launch file failed")
             chosen.run()
             raise
-        return chosen.run()
+        code = chosen.run()  # handles a Ctrl-C received while loading first
+        return 130 if chosen.interrupted_while_loading else code
     finally:
         chosen.restore_signal_handlers()
 

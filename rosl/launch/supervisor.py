@@ -122,6 +122,11 @@ class Supervisor:
         self._interrupts = 0
         self._previous_handlers: dict[int, Any] | None = None
         self._signals: list[int] = []  # received, not yet handled
+        self.loading = False  # the launch file loads: a first SIGINT raises KeyboardInterrupt
+        self.interrupted_while_loading = False  # a SIGINT came before run(): exit 130
+        self._before_run = True
+        self._busy = 0  # inside start(): a SIGINT waits for its end to interrupt the loading
+        self._interrupt_pending = False
         self._watch: tuple[str, str] | None = None
         self._seen = False
 
@@ -177,6 +182,18 @@ class Supervisor:
         label: str | None = None,
     ) -> str:
         """Start a process (or, in a dry run, just record it); return its ``name-N`` label."""
+        self._busy += 1  # a Ctrl-C now must not leave a started process untracked
+        try:
+            return self._start(spec, action, context, label)
+        finally:
+            self._busy -= 1
+            if self._interrupt_pending and not self._busy:
+                self._interrupt_pending = False
+                raise KeyboardInterrupt
+
+    def _start(
+        self, spec: ProcessSpec, action: Any, context: LaunchContext | None, label: str | None
+    ) -> str:
         self.planned.append(spec)
         label = label or f"{spec.name}-{next(self._counter)}"
         self._handle_signals()  # a Ctrl-C meanwhile: start nothing more
@@ -264,8 +281,17 @@ class Supervisor:
 
     def _on_signal(self, signum: int, frame: Any) -> None:
         # only noted here: the handler may run in the middle of a write to the same stream
-        # or launch.log, and a reentrant write raises; handled by the loop and by start()
+        # or launch.log, and a reentrant write raises; handled by the loop and by start().
+        # While the launch file loads (its own code may take any time), a first SIGINT also
+        # ends the loading at once: KeyboardInterrupt, now or as start() ends.
         self._signals.append(signum)
+        if signum == signal.SIGINT and self._before_run and not self.interrupted_while_loading:
+            self.interrupted_while_loading = True
+            if self.loading and self._busy:
+                self._interrupt_pending = True
+            elif self.loading:
+                self.loading = False
+                raise KeyboardInterrupt
 
     def _handle_signals(self) -> None:
         while self._signals:
@@ -307,7 +333,9 @@ class Supervisor:
         """Supervise until every process is gone; return the launch's exit status."""
         installed_here = self._previous_handlers is None
         self.install_signal_handlers()
+        self.loading = self._interrupt_pending = self._before_run = False
         try:
+            self._handle_signals()  # any received while the launch file loaded
             while self._running or (
                 self._shutdown_reason is None and (self._timers or self._respawns)
             ):

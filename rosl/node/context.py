@@ -35,6 +35,7 @@ class Context:
         self.callback_errors = "log"  # or "raise"
         self._initialized = False
         self._shutdown_requested = False
+        self.signalled: int | None = None  # the SIGINT/SIGTERM that asked for the shutdown
         self._on_shutdown: list[Callable[[], None]] = []
         self._previous: dict[int, Any] = {}
         self._lock = threading.RLock()
@@ -128,6 +129,7 @@ class Context:
             if signum == signal.SIGINT:
                 raise KeyboardInterrupt
             raise SystemExit(128 + signum)
+        self.signalled = signum
         self.request_shutdown()
 
 

@@ -60,6 +60,7 @@ def main(argv: list[str]) -> int:
         print(f"{sys.argv[0]}: {line}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
+        interrupts.caught()  # 130, even if the Ctrl-C landed in a class being built
         return 130
 
 

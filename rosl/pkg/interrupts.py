@@ -45,6 +45,17 @@ def prepare_child(hold: bool) -> None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+def caught() -> None:
+    """Say that a KeyboardInterrupt was caught, so that the exit status is the program's own.
+
+    CPython notes a KeyboardInterrupt that leaves code run by ``exec()`` of a string (a
+    dataclass or message class being built, say) and, even if the program caught it later,
+    ends the process at exit by SIGINT (status -2) instead of with the program's status (130).
+    The note is cleared by the next ``exec()`` of a string that ends normally: this one.
+    """
+    exec("None")
+
+
 def release() -> None:
     """Let in a SIGINT held since this program started (a pending one raises here)."""
     if os.environ.pop(HELD, None) is not None:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.launch.support import Output, assert_all_gone
+from tests.launch.support import Output, assert_all_gone, write_launch
 
 if TYPE_CHECKING:
     from tests.conftest import Processes
@@ -28,25 +28,31 @@ if TYPE_CHECKING:
 EXIT_BOUND_S = 30.0  # generous: a clean stop takes well under a second
 FIRST_LINE = r"^\[INFO\] \[launch\]: All log files can be found below "
 STARTED = r"process started with pid"
+# A Ctrl-C before the launch file was loaded and processed exits 130 (the launch never got
+# under way); once the launch runs, its clean stop exits 0, as ros2 launch's does. Near the
+# end of the processing either can happen, depending on when the SIGINT lands.
+LOADING, RUNNING, EITHER = (130,), (0,), (0, 130)
 MOMENTS = {
-    "at the first line": (FIRST_LINE, 1, 0.0),
-    "as the first node starts": (STARTED, 1, 0.0),
-    "as the last node starts": (STARTED, 3, 0.0),
-    "a moment later": (FIRST_LINE, 1, 0.2),
-    "once every node is up": (r"\[timer_node\]: Timer period: 1\.5 s$", 1, 0.0),
+    "at the first line": (FIRST_LINE, 1, 0.0, LOADING),
+    "as the first node starts": (STARTED, 1, 0.0, LOADING),
+    "as the last node starts": (STARTED, 3, 0.0, EITHER),
+    "a moment later": (FIRST_LINE, 1, 0.2, EITHER),
+    "once every node is up": (r"\[timer_node\]: Timer period: 1\.5 s$", 1, 0.0, RUNNING),
 }
 
 
-def start_launch(rosl: Rosl, *, sigint_ignored: bool) -> Output:
+def start_launch(
+    rosl: Rosl, *, sigint_ignored: bool, target: tuple[str, ...] = ("tutorial_pkg", "my_launch.py")
+) -> Output:
     """``rosl launch tutorial_pkg my_launch.py``, with SIGINT ignored as in a background job."""
     if not sigint_ignored:
-        return rosl.start("launch", "tutorial_pkg", "my_launch.py")
+        return rosl.start("launch", *target)
 
     def ignore_sigint() -> None:  # what a shell does for `rosl launch ... &`
         signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     child = subprocess.Popen(
-        [sys.executable, "-m", "rosl", "launch", "tutorial_pkg", "my_launch.py"],
+        [sys.executable, "-m", "rosl", "launch", *target],
         env={**os.environ, "PYTHONUNBUFFERED": "1"}, stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
         preexec_fn=ignore_sigint,
@@ -62,7 +68,7 @@ def start_launch(rosl: Rosl, *, sigint_ignored: bool) -> Output:
 def test_one_sigint_ends_the_launch_cleanly_at_any_moment(
     rosl: Rosl, moment: str, sigint_ignored: bool
 ) -> None:
-    pattern, count, later = MOMENTS[moment]
+    pattern, count, later, codes = MOMENTS[moment]
     launch = start_launch(rosl, sigint_ignored=sigint_ignored)
     assert launch.wait_for(pattern, count=count, timeout=30.0), launch.both()
     if later:
@@ -70,7 +76,7 @@ def test_one_sigint_ends_the_launch_cleanly_at_any_moment(
 
     code = launch.interrupt(signal.SIGINT, timeout=EXIT_BOUND_S)  # once
 
-    assert code == 0, f"exit {code} after one SIGINT\n{launch.both()}"
+    assert code in codes, f"exit {code} after one SIGINT\n{launch.both()}"
     text = launch.text("out") + launch.text("err")
     assert "Traceback" not in text, launch.both()
     assert "Fatal Python error" not in text, launch.both()
@@ -80,6 +86,40 @@ def test_one_sigint_ends_the_launch_cleanly_at_any_moment(
         assert_all_gone(pids)
         for label in launch.started():
             assert launch.matching(rf"^\[(INFO|ERROR)\] \[{label}\]: process has "), launch.both()
+
+
+SLOW_LAUNCH = """
+import sys
+import time
+
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    print("loading the slow launch file", flush=True)
+    time.sleep(30.0)  # bounded: far longer than the test waits for the exit
+    return LaunchDescription([Node(package="tutorial_pkg", executable="timer_node")])
+"""
+LOADING_EXIT_BOUND_S = 10.0  # well under the launch file's 30 s sleep
+
+
+@pytest.mark.parametrize("sigint_ignored", [False, True], ids=["foreground", "background"])
+def test_one_sigint_ends_the_launch_while_its_file_loads(
+    rosl: Rosl, launch_dir: Path, sigint_ignored: bool
+) -> None:
+    path = write_launch(launch_dir, "slow.launch.py", SLOW_LAUNCH)
+    launch = start_launch(rosl, sigint_ignored=sigint_ignored, target=(str(path),))
+    assert launch.wait_for(r"^loading the slow launch file$", timeout=30.0), launch.both()
+
+    code = launch.interrupt(signal.SIGINT, timeout=LOADING_EXIT_BOUND_S)  # once
+
+    assert code is not None, f"still running {LOADING_EXIT_BOUND_S} s after one SIGINT"
+    assert code == 130, f"exit {code} after one SIGINT while loading\n{launch.both()}"
+    text = launch.text("out") + launch.text("err")
+    assert "Traceback" not in text, launch.both()
+    assert launch.matching(r"^\[WARNING\] \[launch\]: user interrupted with ctrl-c \(SIGINT\)$")
+    assert not launch.pids(), launch.both()  # nothing starts after the Ctrl-C
 
 
 def node_interpreter_starting(pid: int, *, catching: bool, timeout: float = 30.0) -> bool:
