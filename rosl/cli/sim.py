@@ -91,3 +91,6 @@ def command(world: str, **options: Any) -> None:
     )  # fmt: skip
     report = simulate(world, sim_options, seed=options["seed"], domain=options["domain_id"])
     render.lines(report.lines())
+    from rosl.node.context import default_context
+
+    default_context.signalled = None  # Ctrl-C is how a paced simulation ends: a clean stop, 0
