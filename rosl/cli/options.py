@@ -60,3 +60,9 @@ def export_domain(domain_id: int | None) -> None:
     from rosl.bus.multicast import domain_from_env
 
     os.environ["ROSL_DOMAIN_ID"] = str(domain_from_env(domain_id))
+
+
+def include_hidden(flag: bool) -> bool:
+    """A verb's ``--include-hidden-*`` flag, or its group's (ros2 takes it on either)."""
+    parent = click.get_current_context().parent
+    return flag or bool(parent is not None and parent.params.get("include_hidden"))

@@ -6,6 +6,7 @@ import click
 
 from rosl.cli import render
 from rosl.cli.options import domain_option
+from rosl.cli.options import include_hidden as hidden_flag
 from rosl.introspection import services
 from rosl.introspection.session import Session, visible
 
@@ -24,12 +25,6 @@ def command(include_hidden: bool) -> None:
     del include_hidden  # read by the verbs: `rosl service --include-hidden-services list`
 
 
-def _hidden(include_hidden: bool) -> bool:
-    """The verb's ``--include-hidden-services``, or the group's (ros2 puts it there)."""
-    parent = click.get_current_context().parent
-    return include_hidden or bool(parent is not None and parent.params.get("include_hidden"))
-
-
 @command.command("list")
 @click.option("-t", "--show-types", is_flag=True, help="Additionally show the service type")
 @click.option(
@@ -42,7 +37,10 @@ def list_(show_types: bool, count: bool, include_hidden: bool, domain_id: int | 
     with Session(domain_id) as session:
         render.lines(
             services.list_services(
-                session, show_types=show_types, count=count, include_hidden=_hidden(include_hidden)
+                session,
+                show_types=show_types,
+                count=count,
+                include_hidden=hidden_flag(include_hidden),
             )
         )
 
@@ -55,7 +53,7 @@ def type_(service_name: str, include_hidden: bool, domain_id: int | None) -> Non
     """Output a service's type (an unknown or hidden one prints nothing and exits 1, as ros2)."""
     with Session(domain_id) as session:
         types = session.graph().services().get(service_name)
-    if not types or not visible(service_name, _hidden(include_hidden)):
+    if not types or not visible(service_name, hidden_flag(include_hidden)):
         raise click.exceptions.Exit(1)
     render.lines(types)
 
@@ -71,7 +69,7 @@ def find(service_type: str, count: bool, include_hidden: bool, domain_id: int | 
     """Output a list of available services of a given type."""
     with Session(domain_id) as session:
         found = services.find_services(
-            session, service_type, include_hidden=_hidden(include_hidden)
+            session, service_type, include_hidden=hidden_flag(include_hidden)
         )
         render.lines([str(len(found))] if count else found)
 

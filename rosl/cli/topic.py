@@ -8,6 +8,7 @@ import click
 
 from rosl.cli import render
 from rosl.cli.options import domain_option
+from rosl.cli.options import include_hidden as hidden_flag
 from rosl.introspection import echo as echo_
 from rosl.introspection import monitor, qos_words, topics
 from rosl.introspection import publish as publish_
@@ -28,12 +29,6 @@ hidden_option = click.option(
 def command(include_hidden: bool) -> None:
     """Various topic related sub-commands."""
     del include_hidden  # read by the verbs: `rosl topic --include-hidden-topics list`
-
-
-def _hidden(include_hidden: bool) -> bool:
-    """The verb's ``--include-hidden-topics``, or the group's (ros2 puts it there)."""
-    parent = click.get_current_context().parent
-    return include_hidden or bool(parent is not None and parent.params.get("include_hidden"))
 
 
 def qos_options(what: str, default_profile: str) -> Callable[[Any], Any]:
@@ -108,7 +103,7 @@ def list_(
                 show_types=show_types,
                 count=count,
                 verbose=verbose,
-                include_hidden=_hidden(include_hidden),
+                include_hidden=hidden_flag(include_hidden),
             )
         )
 
@@ -137,7 +132,7 @@ def type_(topic_name: str, include_hidden: bool, domain_id: int | None) -> None:
     """Print a topic's type (an unknown or hidden one prints nothing and exits 1, as in ros2)."""
     with Session(domain_id) as session:
         types = session.graph().topics().get(topic_name)
-    if not types or not visible(topic_name, _hidden(include_hidden)):
+    if not types or not visible(topic_name, hidden_flag(include_hidden)):
         raise click.exceptions.Exit(1)
     render.lines(types)
 
@@ -152,7 +147,7 @@ def type_(topic_name: str, include_hidden: bool, domain_id: int | None) -> None:
 def find(topic_type: str, count: bool, include_hidden: bool, domain_id: int | None) -> None:
     """Output a list of available topics of a given type."""
     with Session(domain_id) as session:
-        found = topics.find_topics(session, topic_type, include_hidden=_hidden(include_hidden))
+        found = topics.find_topics(session, topic_type, include_hidden=hidden_flag(include_hidden))
         render.lines([str(len(found))] if count else found)
 
 
