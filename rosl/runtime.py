@@ -97,7 +97,7 @@ def spin_once(
 
 def spin_until_future_complete(
     node: Node,
-    future: Future,
+    future: Future[Any],
     executor: Executor | None = None,
     timeout_sec: float | None = None,
 ) -> None:

@@ -2,25 +2,31 @@
 
 A server whose callback raised answers with a failure, which fails the call at once.
 
-``call`` works inside a callback too: it reads only its own channel while it waits and
-queues anything else it reads for the executor, so nothing deadlocks and nothing is lost.
+Responses wait in the client's queue; the executor of the node takes them (completing the
+futures) whatever the client's callback group is doing, so a callback may await
+``call_async``. ``call`` works inside a callback too: it waits on the participant, which
+queues everything else for the executor, and takes its own response.
 """
 
 from __future__ import annotations
 
-import time
+import threading
+from collections import deque
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.bus.wire import Writer
-from rosl.executor import Future
 from rosl.graph.records import CLIENT, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
+from rosl.node.callback_groups import Queued
 from rosl.node.errors import NodeError
 from rosl.node.service import failure_text
+from rosl.node.task import Future
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from rosl.bus.wire import Delivery
     from rosl.idl.messages import ServiceType
     from rosl.node.node import Node
@@ -42,8 +48,10 @@ class ServiceFailedError(NodeError, RuntimeError):
         self.error = error  # "ZeroDivisionError: division by zero"
 
 
-class Client:
+class Client(Queued):
     """Calls one service (rclpy.client.Client)."""
+
+    _ungrouped = True  # completing a future never waits for the client's group
 
     def __init__(self, node: Node, srv_type: type[ServiceType], name: str) -> None:
         self.node = node
@@ -60,7 +68,10 @@ class Client:
             Kind.REQUEST,
         )  # fmt: skip
         self._store = registry.store()
-        self._pending: dict[int, Future] = {}
+        self._pending: dict[int, Future[Any]] = {}
+        self._queue: deque[Delivery] = deque()
+        self._lock = threading.Lock()  # a response may be taken on another thread at once
+        self._what = name
         self.destroyed = False
         participant.listen(self._topic, self)
 
@@ -77,7 +88,7 @@ class Client:
 
     # --- calling -----------------------------------------------------------------------------
 
-    def call_async(self, request: Any) -> Future:
+    def call_async(self, request: Any) -> Future[Any]:
         """Send a request; the returned Future completes with the response.
 
         When the server's callback raises, the future fails instead: ``exception()`` is a
@@ -88,43 +99,44 @@ class Client:
             raise TypeError(
                 f"client of {self.srv_name} sends {expected}, not {type(request).__name__}"
             )
-        future = Future()
-        seq = self._writer.send(self._store.serialize(request))
-        self._pending[seq] = future
+        future: Future[Any] = Future()
+        payload = self._store.serialize(request)
+        with self._lock:
+            seq = self._writer.send(payload)
+            self._pending[seq] = future
         return future
 
     def call(self, request: Any, timeout_sec: float | None = None) -> Any:
         """Send a request and wait for the response (safe inside callbacks).
 
         Raises:
-            ServiceTimeoutError: no response within ``timeout_sec`` (None waits without limit).
+            ServiceTimeoutError: no response within ``timeout_sec`` (None waits without limit)
+                or the context was shut down meanwhile.
             ServiceFailedError: the server's callback raised (reported at once).
         """
         future = self.call_async(request)
-        deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
         participant = self.node.participant
-        while not future.done():
-            remaining = 0.05 if deadline is None else min(0.05, deadline - time.monotonic())
-            if remaining <= 0:
-                self.remove_pending_request(future)
-                raise ServiceTimeoutError(
-                    f"service {self.srv_name} did not answer within {timeout_sec} s"
-                )
-            others = []
-            for delivery in participant.read_channel(self._topic, remaining):
-                if delivery.topic == self._topic and self._mine(delivery):
-                    self.deliver(delivery)
-                else:
-                    others.append(delivery)
-            if others:
-                participant.defer(others)
+        context = self.node.context
+        future.add_done_callback(lambda _: participant.notify())
+
+        def answered() -> bool:
+            while self._take() is not None:
+                pass
+            return future.done() or not context.ok()
+
+        participant.wait(answered, timeout_sec)
+        if not future.done():
+            self.remove_pending_request(future)
+            why = "before shutdown" if not context.ok() else f"within {timeout_sec} s"
+            raise ServiceTimeoutError(f"service {self.srv_name} did not answer {why}")
         return future.result()
 
-    def remove_pending_request(self, future: Future) -> None:
+    def remove_pending_request(self, future: Future[Any]) -> None:
         """Forget a request whose response is no longer wanted."""
-        for seq, pending in list(self._pending.items()):
-            if pending is future:
-                del self._pending[seq]
+        with self._lock:
+            for seq, pending in list(self._pending.items()):
+                if pending is future:
+                    del self._pending[seq]
 
     def _mine(self, delivery: Delivery) -> bool:
         address = delivery.address
@@ -136,21 +148,30 @@ class Client:
         )
 
     def deliver(self, delivery: Delivery) -> None:
-        """Complete the future of the request this response answers."""
-        if not self._mine(delivery) or delivery.address is None:
-            return
-        future = self._pending.pop(delivery.address[2], None)
+        """Queue a response to one of this client's requests (on the polling thread)."""
+        if self._mine(delivery):
+            self._queue.append(delivery)
+
+    def _take(self) -> Callable[[], Any] | None:
+        """Complete the future the oldest queued response answers (no callback to run)."""
+        delivery = self._pop()
+        if delivery is None:
+            return None
+        address = delivery.address
+        with self._lock:
+            future = None if address is None else self._pending.pop(address[2], None)
         if future is None:
-            return
+            return None
         if delivery.kind == Kind.FAILURE:
             future.set_exception(ServiceFailedError(self.srv_name, failure_text(delivery.payload)))
-            return
+            return None
         try:
             response = self._store.deserialize(delivery.payload, self.srv_type.Response.__msgtype__)
         except InterfaceError as err:
             future.set_exception(err)
-            return
+            return None
         future.set_result(response)
+        return None
 
     def record(self) -> EndpointRecord:
         """This client as discovery announces it."""

@@ -7,14 +7,17 @@ discovery cache.
 
 from __future__ import annotations
 
+import itertools
 import sys
 import traceback
+import weakref
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, NodeRecord
 from rosl.idl.base import Message, ServiceType
 from rosl.node import names
+from rosl.node.callback_groups import CallbackGroup, MutuallyExclusiveCallbackGroup
 from rosl.node.clock import NS, Clock, ClockType, Duration
 from rosl.node.context import Context, default_context
 from rosl.node.logging import Logger
@@ -30,14 +33,18 @@ from rosl.node.qos import (
 _ROSL_DIR = str(Path(__file__).resolve().parent.parent)
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Sequence
+    from collections.abc import Callable, Iterator, Sequence
 
+    from rosl.executor import Executor
+    from rosl.node.callback_groups import Executable
     from rosl.node.client import Client
+    from rosl.node.guard_condition import GuardCondition
     from rosl.node.participant import Participant
     from rosl.node.publisher import Publisher
     from rosl.node.service import Service
     from rosl.node.subscription import Subscription
     from rosl.node.timer import Rate, Timer
+    from rosl.node.waitable import Waitable
 
 
 class Node:
@@ -73,6 +80,11 @@ class Node:
         self.timers: list[Timer] = []
         self.services: list[Service] = []
         self.clients: list[Client] = []
+        self.guards: list[GuardCondition] = []
+        self.waitables: list[Waitable] = []
+        self.default_callback_group: CallbackGroup = MutuallyExclusiveCallbackGroup()
+        self.callback_groups: list[CallbackGroup] = [self.default_callback_group]
+        self._executor: weakref.ref[Executor] | None = None
         self._destroyed = False
         self._clock = Clock(clock_type=ClockType.ROS_TIME)
         self._clock_subscription: Subscription | None = None
@@ -182,20 +194,21 @@ class Node:
         msg_type: type[Message],
         topic: str,
         callback: Callable[..., Any],
-        qos_profile: QoSProfile | int,
+        qos_profile: QoSProfile | int = 10,
         *,
-        callback_group: Any = None,
+        callback_group: CallbackGroup | None = None,
         event_callbacks: Any = None,
         raw: bool = False,
     ) -> Subscription:
         """Call ``callback(msg)`` for each message on ``topic``."""
         from rosl.node.subscription import Subscription
 
-        del callback_group, event_callbacks
+        del event_callbacks
         subscription = Subscription(
             self, _message_class(msg_type), self.resolve_topic_name(topic), callback,
             as_profile(qos_profile), raw,
         )  # fmt: skip
+        self._join(subscription, callback_group)
         self.subscriptions.append(subscription)
         self.participant.discovery.changed()
         return subscription
@@ -204,7 +217,7 @@ class Node:
         self,
         timer_period_sec: float,
         callback: Callable[[], Any] | None,
-        callback_group: Any = None,
+        callback_group: CallbackGroup | None = None,
         clock: Clock | None = None,
     ) -> Timer:
         """Call ``callback`` every ``timer_period_sec`` seconds of this node's clock.
@@ -216,16 +229,16 @@ class Node:
         from rosl.node.errors import TimerPeriodError
         from rosl.node.timer import Timer, seconds_to_period_ns
 
-        del callback_group
         try:
             period = seconds_to_period_ns(timer_period_sec)
         except TimerPeriodError as err:
             held = self._parameters.holding(timer_period_sec)
             hint = f" (the value of parameter '{held[0]}')" if len(held) == 1 else ""
             raise TimerPeriodError(f"{err}{hint}") from None
-        timer = Timer(callback, period, clock or self._clock, self.participant.wake)
+        timer = Timer(callback, period, clock or self._clock, self.participant.notify)
+        self._join(timer, callback_group)
         self.timers.append(timer)
-        self.participant.wake()
+        self.participant.notify()
         return timer
 
     def create_rate(self, frequency: float, clock: Clock | None = None) -> Rate:
@@ -241,15 +254,16 @@ class Node:
         callback: Callable[[Any, Any], Any],
         *,
         qos_profile: QoSProfile | None = None,
-        callback_group: Any = None,
+        callback_group: CallbackGroup | None = None,
     ) -> Service:
         """Serve ``srv_name``: ``callback(request, response)`` returns the response."""
         from rosl.node.service import Service
 
-        del qos_profile, callback_group
+        del qos_profile
         service = Service(
             self, _service_class(srv_type), self.resolve_service_name(srv_name), callback
         )
+        self._join(service, callback_group)
         self.services.append(service)
         self.participant.discovery.changed()
         return service
@@ -260,16 +274,78 @@ class Node:
         srv_name: str,
         *,
         qos_profile: QoSProfile | None = None,
-        callback_group: Any = None,
+        callback_group: CallbackGroup | None = None,
     ) -> Client:
         """A client of ``srv_name``."""
         from rosl.node.client import Client
 
-        del qos_profile, callback_group
+        del qos_profile
         client = Client(self, _service_class(srv_type), self.resolve_service_name(srv_name))
+        self._join(client, callback_group)
         self.clients.append(client)
         self.participant.discovery.changed()
         return client
+
+    def create_guard_condition(
+        self, callback: Callable[[], Any], callback_group: CallbackGroup | None = None
+    ) -> GuardCondition:
+        """A guard condition: ``trigger()`` (any thread) makes the executor run ``callback``."""
+        from rosl.node.guard_condition import GuardCondition
+
+        guard = GuardCondition(callback, None, self.context)
+        self._join(guard, callback_group)
+        self.guards.append(guard)
+        return guard
+
+    def destroy_guard_condition(self, guard: GuardCondition) -> bool:
+        """Remove a guard condition."""
+        guard.destroy()
+        if guard not in self.guards:
+            return False
+        self.guards.remove(guard)
+        return True
+
+    def add_waitable(self, waitable: Waitable) -> None:
+        """Let this node's executor run ``waitable``."""
+        if waitable.callback_group is None:
+            self._join(waitable, None)
+        self.waitables.append(waitable)
+        self.participant.notify()
+
+    def remove_waitable(self, waitable: Waitable) -> None:
+        """Stop running ``waitable``."""
+        if waitable in self.waitables:
+            self.waitables.remove(waitable)
+
+    def _join(self, entity: Executable, group: CallbackGroup | None) -> None:
+        chosen = group if group is not None else self.default_callback_group
+        entity.callback_group = chosen
+        chosen.add_entity(entity)
+        if chosen not in self.callback_groups:
+            self.callback_groups.append(chosen)
+
+    def _entities(self) -> Iterator[Executable]:
+        """What an executor looks at, in rclpy's order."""
+        return itertools.chain(
+            self.waitables, self.timers, self.subscriptions, self.guards, self.clients,
+            self.services,
+        )  # fmt: skip
+
+    @property
+    def executor(self) -> Executor | None:
+        """The executor running this node's callbacks (setting it moves the node there)."""
+        return None if self._executor is None else self._executor()
+
+    @executor.setter
+    def executor(self, executor: Executor | None) -> None:
+        current = self.executor
+        if current is executor:
+            return
+        self._executor = None if executor is None else weakref.ref(executor)
+        if current is not None:
+            current.remove_node(self)
+        if executor is not None:
+            executor.add_node(self)
 
     def _publisher_for(self, type_name: str, topic: str, qos: QoSProfile) -> Publisher:
         from rosl.idl.registry import get_message_class
@@ -325,9 +401,12 @@ class Node:
             client.close()
         for timer in self.timers:
             timer.destroy()
+        for guard in self.guards:
+            guard.destroy()
         for publisher in self.publishers:
             self.participant.remove_replayer(publisher.topic, publisher)
         self.participant.remove_node(self.index)
+        self.executor = None
         if self in self.context.nodes:
             self.context.nodes.remove(self)
 
@@ -381,15 +460,6 @@ class Node:
         self._clock.set_sim_now(msg.clock.sec * NS + msg.clock.nanosec)
 
     # --- callbacks ---------------------------------------------------------------------------
-
-    def run_callback(self, call: Callable[[], Any], what: str) -> None:
-        """Run a user callback; an exception is logged with this node's name (or re-raised)."""
-        try:
-            call()
-        except (KeyboardInterrupt, SystemExit):
-            raise
-        except Exception as err:
-            self._callback_failed(err, what)
 
     def _callback_failed(self, err: Exception, what: str) -> None:
         """Log a user callback's exception and its line (re-raised in ``raise`` mode)."""

@@ -2,9 +2,9 @@
 
 One participant per process (created with the first node, or by a CLI that only observes).
 It reaches the network only through the transport seam (:mod:`rosl.bus.transport`): its
-receiver is polled on the thread that spins — deliveries go straight to the endpoint's
-handler, with no thread hand-off. The discovery thread answers graph queries even while the
-user's callbacks run.
+receiver is polled by a thread that waits for work (:meth:`Participant.wait`): deliveries go
+to their entity's queue, and a single-threaded executor runs them with no thread hand-off.
+The discovery thread answers graph queries even while the user's callbacks run.
 """
 
 from __future__ import annotations
@@ -12,9 +12,10 @@ from __future__ import annotations
 import itertools
 import os
 import threading
+import time
 from typing import TYPE_CHECKING, Protocol, cast
 
-from rosl.bus.header import Flags, topic_hash
+from rosl.bus.header import topic_hash
 from rosl.bus.transport import CHANNELS, channel_of, open_transport
 from rosl.graph.announce import Discovery
 
@@ -54,8 +55,13 @@ class Participant:
         self._node_ids = itertools.count(1)
         self._describers: dict[int, Callable[[], NodeRecord]] = {}
         self._handlers: dict[int, list[Handler]] = {}
-        self._deferred: list[Delivery] = []
         self._lock = threading.RLock()
+        self._cond = threading.Condition(threading.Lock())  # executors waiting for work
+        self._waiting = 0  # threads asleep on _cond
+        self._poll_lock = threading.Lock()  # one thread polls the receiver at a time
+        self._poller: int | None = None  # that thread
+        self.changes = 0  # counts notify() calls: a waiter that computed its timeout from an
+        # older state returns at once (see wait)
         self._replayers: dict[str, list[Replayer]] = {}
         self.writers: list[Writer] = []  # the publishers' writers (lock-step answers list them)
         self.answerer: Answerer | None = None  # created when an executor first spins
@@ -163,9 +169,65 @@ class Participant:
 
     # --- receiving ---------------------------------------------------------------------------
 
-    def wake(self) -> None:
-        """Wake a thread blocked in :meth:`poll`."""
-        self._receiver.wake()
+    def notify(self) -> None:
+        """Something an executor waits for changed: wake the threads in :meth:`wait`.
+
+        A thread blocked polling the receiver is woken too (also when it is the caller: a
+        signal handler runs on the thread blocked in the poll).
+        """
+        self.changes += 1
+        if self._poller is not None:
+            self._receiver.wake()
+        if self._waiting:
+            with self._cond:
+                self._cond.notify_all()
+
+    wake = notify
+
+    def wait(
+        self, ready: Callable[[], bool], timeout: float | None, since: int | None = None
+    ) -> bool:
+        """Block until ``ready()`` or ``timeout`` seconds (None: no limit); return ``ready()``.
+
+        Meanwhile the receiver is polled by one waiting thread at a time (the others sleep
+        until it has dispatched): a single-threaded executor reads its own deliveries, with
+        no thread hand-off. ``ready`` is called again after each dispatch and wake-up.
+        With ``since`` (a :attr:`changes` value read before the caller chose ``timeout``),
+        it returns as soon as anything notified since then.
+        """
+        deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
+        first = True
+        while True:
+            if ready() or (since is not None and self.changes != since):
+                return ready()
+            remaining = None if deadline is None else deadline - time.monotonic()
+            if remaining is not None:
+                if remaining <= 0 and not first:
+                    return False
+                remaining = max(0.0, remaining)
+            first = False
+            if not self.closed and self._poll_lock.acquire(blocking=False):
+                try:
+                    self._poller = threading.get_ident()
+                    # checked after claiming the poll: a notify from now on wakes us
+                    if ready() or (since is not None and self.changes != since):
+                        return ready()
+                    self._poll_locked(remaining, None)
+                finally:
+                    self._poller = None
+                    self._poll_lock.release()
+                if self._waiting:  # another thread may take over polling, or was served
+                    with self._cond:
+                        self._cond.notify_all()
+                continue
+            with self._cond:
+                self._waiting += 1
+                try:
+                    if ready() or (since is not None and self.changes != since):
+                        return ready()
+                    self._cond.wait(remaining if remaining is not None or not self.closed else 0.1)
+                finally:
+                    self._waiting -= 1
 
     def poll(self, timeout: float | None, sink: Callable[[Delivery], None] | None = None) -> int:
         """Wait up to ``timeout`` for datagrams, then dispatch every complete message.
@@ -175,15 +237,28 @@ class Participant:
             sink: receives every delivery instead of the registered handlers (monitors).
 
         Returns:
-            How many messages were dispatched.
+            How many messages were dispatched (0 when another thread was polling
+            throughout ``timeout``: it dispatches them).
         """
         if self.closed:
             return 0
-        with self._lock:
-            deliveries, self._deferred = self._deferred, []
-        pending = bool(deliveries)
-        channels = self._receiver.poll(0.0 if pending else timeout, deliveries)
-        if channels > 1 or pending:
+        if not self._poll_lock.acquire(timeout=-1 if timeout is None else max(0.0, timeout)):
+            return 0
+        try:
+            self._poller = threading.get_ident()
+            count = self._poll_locked(timeout, sink)
+        finally:
+            self._poller = None
+            self._poll_lock.release()
+        if count and self._waiting:
+            with self._cond:
+                self._cond.notify_all()
+        return count
+
+    def _poll_locked(self, timeout: float | None, sink: Callable[[Delivery], None] | None) -> int:
+        deliveries: list[Delivery] = []
+        channels = self._receiver.poll(timeout, deliveries)
+        if channels > 1:
             deliveries.sort(key=_send_order)  # in the order they were sent, across channels
         for delivery in deliveries:
             if sink is not None:
@@ -193,12 +268,13 @@ class Participant:
         return len(deliveries)
 
     def dispatch(self, delivery: Delivery) -> None:
-        """Hand one delivery to the handlers of its topic/service hash."""
-        handlers = self._handlers.get(delivery.topic, ())
-        for handler in handlers:
+        """Hand one delivery to the handlers of its topic/service hash.
+
+        Node entities queue it for their executor; taps (monitors, the simulator's lock-step
+        end) take it at once, on the polling thread.
+        """
+        for handler in self._handlers.get(delivery.topic, ()):
             handler.deliver(delivery)
-        if delivery.flags & _LOCKSTEP and handlers and self.answerer is not None:
-            self.answerer.handled(delivery)
 
     def answer_lockstep(self) -> Answerer:
         """Start answering lock-stepped simulators (announced in this process's record)."""
@@ -209,21 +285,6 @@ class Participant:
             self.discovery.lockstep = True
             self.discovery.changed()
         return self.answerer
-
-    def defer(self, deliveries: list[Delivery]) -> None:
-        """Queue deliveries read by a nested wait for the next :meth:`poll`."""
-        with self._lock:
-            self._deferred.extend(deliveries)
-        self.wake()
-
-    def read_channel(self, channel_topic: int, timeout: float) -> list[Delivery]:
-        """Wait up to ``timeout`` on one topic's channel and return what arrived (undispatched).
-
-        Used by blocking calls (``Client.call``) that must not run other callbacks.
-        """
-        found: list[Delivery] = []
-        self._receiver.poll(max(0.0, timeout), found, channel=channel_of(channel_topic))
-        return found
 
     def flusher(self) -> Flusher:
         """The thread that sends coalescing publishers' batches on time (started lazily)."""
@@ -247,11 +308,8 @@ class Participant:
             self._flusher.close()
         self.closed = True
         self.discovery.stop()
-        self.wake()
+        self.notify()
         self.transport.close()
-
-
-_LOCKSTEP = int(Flags.LOCKSTEP)  # a plain int: enum operators are slow per message
 
 
 def _send_order(delivery: Delivery) -> int:

@@ -9,7 +9,10 @@ traffic (recorders, ``service echo``) see only requests and responses.
 from __future__ import annotations
 
 import contextlib
+import functools
+import inspect
 import json
+from collections import deque
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind, topic_hash, type_hash
@@ -18,10 +21,11 @@ from rosl.errors import RoslError
 from rosl.graph.records import SERVER, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
+from rosl.node.callback_groups import Queued
 
 if TYPE_CHECKING:
     import mmap
-    from collections.abc import Callable
+    from collections.abc import Callable, Coroutine
 
     from rosl.bus.wire import Delivery
     from rosl.idl.messages import ServiceType
@@ -43,8 +47,14 @@ def failure_text(payload: bytes | bytearray | memoryview | mmap.mmap) -> str:
     return f"{kind}: {message}" if message else kind
 
 
-class Service:
-    """Serves one service name (rclpy.service.Service)."""
+REQUESTS_KEPT = 4096  # requests waiting for the callback before the oldest is dropped
+
+
+_REQUEST = int(Kind.REQUEST)
+
+
+class Service(Queued):
+    """Serves one service name (rclpy.service.Service); the callback may be a coroutine."""
 
     def __init__(
         self,
@@ -69,30 +79,59 @@ class Service:
         self._store = registry.store()
         self.handled = 0
         self.destroyed = False
+        self._queue: deque[Delivery] = deque(maxlen=REQUESTS_KEPT)
+        self._what = name
         participant.listen(self._topic, self)
 
     def deliver(self, delivery: Delivery) -> None:
-        """Answer one request."""
-        if delivery.kind != Kind.REQUEST or self.destroyed:
-            return
+        """Queue one request for the executor (on the polling thread)."""
+        if delivery.kind == _REQUEST and not self.destroyed:
+            self._queue.append(delivery)
+
+    def _take(self) -> Callable[[], Any] | None:
+        """Take the oldest request: the call that answers it."""
+        delivery = self._pop()
+        if delivery is None:
+            return None
         if delivery.type != self._type:
             self.node.get_logger().warn(
                 f"service {self.service_name} ({self.type_name}) got a request of another "
                 "type; ignored",
                 once=True,
             )
-            return
+            return None
         try:
             request = self._store.deserialize(delivery.payload, self.srv_type.Request.__msgtype__)
         except InterfaceError as err:
             self.node.get_logger().warn(f"service {self.service_name}: bad request: {err}")
-            return
+            return None
         address = (delivery.sender, delivery.endpoint, delivery.seq)
-        self.node.run_callback(lambda: self._answer(request, address), self.service_name)
+        return functools.partial(self._answer, request, address)
 
-    def _answer(self, request: Any, address: tuple[int, int, int]) -> None:
+    def _answer(self, request: Any, address: tuple[int, int, int]) -> Any:
+        """Run the callback and send its response (a coroutine callback: once it returns)."""
         try:
             response = self.callback(request, self.srv_type.Response())
+        except Exception as err:
+            self._fail(err, address)
+            raise  # logged with the node's name by the executor; the server keeps serving
+        if inspect.iscoroutine(response):
+            return self._answer_later(response, address)
+        self._respond(response, address)
+        return None
+
+    async def _answer_later(
+        self, pending: Coroutine[Any, Any, Any], address: tuple[int, int, int]
+    ) -> None:
+        try:
+            response = await pending
+        except Exception as err:
+            self._fail(err, address)
+            raise
+        self._respond(response, address)
+
+    def _respond(self, response: Any, address: tuple[int, int, int]) -> None:
+        try:
             if getattr(response, "__msgtype__", None) != self.srv_type.Response.__msgtype__:
                 raise TypeError(
                     f"service {self.service_name} callback must return a "
@@ -101,7 +140,7 @@ class Service:
             payload = self._store.serialize(response)
         except Exception as err:
             self._fail(err, address)
-            raise  # logged with the node's name by run_callback; the server keeps serving
+            raise
         self._writer.send(payload, address=address)
         self.handled += 1
 

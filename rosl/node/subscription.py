@@ -1,4 +1,7 @@
-"""Subscriptions: check the type hash, decode, call back — on the thread that read the socket.
+"""Subscriptions: queue deliveries for the executor; check the type hash, decode, call back.
+
+Deliveries wait in a queue as deep as the QoS history (keep-last: the oldest goes when it is
+full, counted as ``dropped``); the executor that runs the node takes them one at a time.
 
 A message whose type differs from the subscription's is dropped undecoded and reported once
 (never mis-decoded); so is one from a publisher whose definition of the same type name differs
@@ -9,15 +12,18 @@ taking two arguments also get the message info (timestamps, sequence).
 
 from __future__ import annotations
 
+import functools
 import inspect
 from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rosl.bus.header import Kind, topic_hash, type_hash
+from rosl.bus.header import Flags, Kind, topic_hash, type_hash
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
+from rosl.node.callback_groups import Queued
+from rosl.node.qos import HistoryPolicy
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -29,7 +35,16 @@ if TYPE_CHECKING:
 
 
 _REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster than enums
+_LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
+KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
+
+
+def queue_depth(qos: QoSProfile) -> int:
+    """How many deliveries wait for the callback: the history depth (keep-all: a bound)."""
+    if qos.history is HistoryPolicy.KEEP_ALL:
+        return KEEP_ALL_LIMIT
+    return max(1, qos.depth)
 
 
 def _wants_info(callback: Callable[..., Any]) -> bool:
@@ -53,7 +68,7 @@ class _Peer:
     stats: StreamStats | None  # its stream's sequence bookkeeping (loss)
 
 
-class Subscription:
+class Subscription(Queued):
     """Receives one topic's messages (rclpy.subscription.Subscription)."""
 
     def __init__(
@@ -87,7 +102,10 @@ class Subscription:
         self.log_loss = True  # False for tools that report loss in their own words (echo)
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
+        self._queue: deque[Delivery] = deque(maxlen=queue_depth(qos))
+        self._what = topic
         self.received = 0
+        self.dropped = 0  # deliveries pushed out of a full queue (the callback fell behind)
         self.mismatched = 0
         self.undecodable = 0
         self._warned: set[int] = set()
@@ -111,29 +129,47 @@ class Subscription:
         )
 
     def deliver(self, delivery: Delivery) -> None:
-        """Decode one delivery for this topic and call back."""
+        """Queue one delivery for this topic (on the polling thread)."""
         if self.destroyed:
             return
-        if delivery.kind == _REPLAY:
+        kind = delivery.kind
+        if kind == _REPLAY:
             address = delivery.address
             if address is None or address[0] != self._sender or address[1] != self.endpoint:
-                return
+                return  # history asked for by another subscription
+        elif kind != _DATA:
+            return
+        queue = self._queue
+        if len(queue) == queue.maxlen:
+            self.dropped += 1
+        queue.append(delivery)
+
+    def _take(self) -> Callable[[], Any] | None:
+        """Take the oldest queued delivery: the call of the callback with its message."""
+        delivery = self._pop()
+        if delivery is None:
+            return None
+        if delivery.flags & _LOCKSTEP:
+            answerer = self.node.participant.answerer
+            if answerer is not None:
+                answerer.handled(delivery)
+        if self.destroyed:
+            return None
+        if delivery.kind == _REPLAY:
             replayed = (delivery.sender, delivery.endpoint, delivery.seq)
             if replayed in self._replayed:
-                return
+                return None
             self._replayed.append(replayed)
-        elif delivery.kind != _DATA:
-            return
         if delivery.type != self._type_hash:
             self._mismatch(delivery)
-            return
+            return None
         key = (delivery.sender, delivery.endpoint)
         peer = self._peers.get(key)
         if peer is None or (peer.agrees is None and peer.generation != self._graph.generation):
             peer = self._peers[key] = self._meet(delivery)
         if peer.agrees is False:
             self.mismatched += 1
-            return
+            return None
         if delivery.kind == _DATA:
             if self.qos_profile.keeps_history:
                 self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
@@ -150,7 +186,7 @@ class Subscription:
                 self.undecodable += 1
                 if self.undecodable == 1:
                     self.node.get_logger().warn(f"dropped a message on {self.topic}: {err}")
-                return
+                return None
         self.received += 1
         if self._with_info:
             info = {
@@ -160,9 +196,8 @@ class Subscription:
                 "reception_sequence_number": self.received,
                 "publisher_gid": (delivery.sender, delivery.endpoint),
             }
-            self.node.run_callback(lambda: self.callback(message, info), self.topic)
-        else:
-            self.node.run_callback(lambda: self.callback(message), self.topic)
+            return functools.partial(self.callback, message, info)
+        return functools.partial(self.callback, message)
 
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1
@@ -218,7 +253,8 @@ class Subscription:
         """This subscription as discovery announces it."""
         return EndpointRecord(
             SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
-            {"received": self.received, "lost": self.lost, "mismatched": self.mismatched},
+            {"received": self.received, "lost": self.lost, "dropped": self.dropped,
+             "mismatched": self.mismatched},
             self.digest,
         )  # fmt: skip
 

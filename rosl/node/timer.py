@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from rosl.node.callback_groups import Executable
 from rosl.node.clock import NS, Duration
 from rosl.node.errors import TimerPeriodError
 
@@ -50,8 +51,11 @@ def _checked_ns(nanoseconds: int) -> int:
     return int(nanoseconds)
 
 
-class Timer:
+class Timer(Executable):
     """Calls ``callback`` every ``timer_period_ns`` on ``clock`` (rclpy.timer.Timer)."""
+
+    _is_timer = True
+    _what = "timer"
 
     def __init__(
         self,
@@ -135,14 +139,26 @@ class Timer:
 
     def call(self) -> None:
         """Mark the call done and run the callback (missed periods are skipped, as in rcl)."""
+        self._advance()
+        if self.callback is not None:
+            self.callback()
+
+    def _ready(self) -> bool:
+        return self.is_ready()
+
+    def _take(self) -> Callable[[], Any] | None:
+        if not self.is_ready() or self.destroyed:
+            return None
+        self._advance()
+        return self.callback
+
+    def _advance(self) -> None:
         now = self.clock.now_ns()
         self._last_call_ns = now
         self._next_call_ns += self._period_ns
         if self._next_call_ns <= now:
             behind = (now - self._next_call_ns) // self._period_ns + 1
             self._next_call_ns += behind * self._period_ns
-        if self.callback is not None:
-            self.callback()
 
     def destroy(self) -> None:
         """Stop for good."""

@@ -83,6 +83,11 @@ class SimNode:
 
         self.sim = sim
         self.node = node
+        from rosl.executor import SingleThreadedExecutor
+
+        self.executor = SingleThreadedExecutor(context=node.context)  # /cmd_vel, parameters
+        self.executor.answers_lockstep = False  # the simulator is the one waiting for answers
+        self.executor.add_node(node)
         self.options = options
         self._log = log or (lambda line: print(line, file=sys.stderr, flush=True))
         self.lockstep: LockstepSource | None = None
@@ -278,8 +283,7 @@ class SimNode:
         if self.lockstep is not None:
             replies = self.lockstep.wait(self.sim.now_ns)
             self.lockstep.settle(replies)
-        else:
-            self.node.participant.poll(0.0)
+        self.executor.spin_some()  # the replies (a /cmd_vel) act before the next step
         recorder = self.recorder
         participant = recorder.participant if recorder is not None else None
         if recorder is not None and participant is not None:
@@ -307,12 +311,11 @@ class SimNode:
         """Real-time factor pacing: serve the bus until the next step is due in wall time."""
         factor = self.options.real_time_factor
         due = started + (self.sim.now_ns + self.sim.step_ns) / NS / factor
-        participant = self.node.participant
         while True:
             remaining = due - time.monotonic()
             if remaining <= 0:
                 return
-            participant.poll(remaining)
+            self.executor.spin_once(remaining)
 
     def _wait_for_peers(self) -> None:
         """Lock-step: start when the named nodes (or a publisher of each cmd_vel) are up."""
@@ -345,7 +348,7 @@ class SimNode:
         self._log(f"[INFO] [sim]: lock-step: waiting for {what} (up to {limit})")  # not /rosout
         deadline = time.monotonic() + self.options.startup_timeout
         while not ready() and time.monotonic() < deadline and self.node.context.ok():
-            self.node.participant.poll(0.05)
+            self.executor.spin_some(0.05)
         if not ready():
             self._log(
                 f"[WARN] [sim]: lock-step: {what} did not come up in "

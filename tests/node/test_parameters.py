@@ -499,7 +499,10 @@ def test_a_namespaced_nodes_parameter_services_live_under_its_full_name(ros):
     client = other.create_client(GetParameters, "/robot/cam/get_parameters")
     assert client.wait_for_service(timeout_sec=20.0)
     future = client.call_async(GetParameters.Request(names=["fps"]))
-    ros.spin_until_future_complete(other, future, timeout_sec=15.0)
+    executor = ros.SingleThreadedExecutor()  # runs both nodes: an executor runs only its own
+    executor.add_node(node)
+    executor.add_node(other)
+    executor.spin_until_future_complete(future, timeout_sec=15.0)
     assert future.done()
     assert future.result().values[0].integer_value == 30
     assert ("/robot/cam/set_parameters", ["rcl_interfaces/srv/SetParameters"]) in (

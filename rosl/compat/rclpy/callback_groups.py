@@ -1,16 +1,9 @@
-"""rclpy.callback_groups: accepted and ignored (callbacks run one at a time)."""
+"""rclpy.callback_groups."""
 
-
-class CallbackGroup:
-    """Accepted for compatibility."""
-
-
-class MutuallyExclusiveCallbackGroup(CallbackGroup):
-    """Accepted for compatibility."""
-
-
-class ReentrantCallbackGroup(CallbackGroup):
-    """Accepted for compatibility."""
-
+from rosl.node.callback_groups import (
+    CallbackGroup,
+    MutuallyExclusiveCallbackGroup,
+    ReentrantCallbackGroup,
+)
 
 __all__ = ["CallbackGroup", "MutuallyExclusiveCallbackGroup", "ReentrantCallbackGroup"]

@@ -1,5 +1,5 @@
 """rclpy.task."""
 
-from rosl.executor import Future
+from rosl.node.task import Future, Task
 
-__all__ = ["Future"]
+__all__ = ["Future", "Task"]

@@ -1,0 +1,5 @@
+"""rclpy.guard_condition."""
+
+from rosl.node.guard_condition import GuardCondition
+
+__all__ = ["GuardCondition"]

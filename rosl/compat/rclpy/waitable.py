@@ -1,0 +1,5 @@
+"""rclpy.waitable."""
+
+from rosl.node.waitable import NumberOfEntities, Waitable
+
+__all__ = ["NumberOfEntities", "Waitable"]

@@ -1,0 +1,134 @@
+"""Callback groups: which of a node's callbacks may run at the same time (rclpy's classes).
+
+An executor asks an entity's group ``can_execute`` before offering its callback, and
+``beginning_execution`` / ``ending_execution`` around running it; a custom group subclasses
+:class:`CallbackGroup` and decides all three. Every node has a mutually exclusive default
+group. Entities are kept by weak reference, as in rclpy.
+"""
+
+from __future__ import annotations
+
+import threading
+import weakref
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from collections import deque
+    from collections.abc import Callable
+
+    from rosl.bus.wire import Delivery
+
+
+class CallbackGroup:
+    """The base of callback groups: remembers its entities; subclasses decide execution."""
+
+    def __init__(self) -> None:
+        self.entities: set[weakref.ref[Any]] = set()
+
+    def add_entity(self, entity: Any) -> None:
+        """Make ``entity`` (a subscription, timer, service, client, guard condition) a member."""
+        self.entities.add(weakref.ref(entity))
+
+    def has_entity(self, entity: Any) -> bool:
+        """Whether ``entity`` belongs to this group."""
+        return weakref.ref(entity) in self.entities
+
+    def can_execute(self, entity: Any) -> bool:
+        """Whether a callback of ``entity`` could start now."""
+        raise NotImplementedError
+
+    def beginning_execution(self, entity: Any) -> bool:
+        """Claim the right to run ``entity``'s callback now; False when the group refuses."""
+        raise NotImplementedError
+
+    def ending_execution(self, entity: Any) -> None:
+        """``entity``'s callback finished."""
+        raise NotImplementedError
+
+
+class ReentrantCallbackGroup(CallbackGroup):
+    """Its callbacks may run at the same time, also several of one entity."""
+
+    def can_execute(self, entity: Any) -> bool:
+        """Always."""
+        return True
+
+    def beginning_execution(self, entity: Any) -> bool:
+        """Always granted."""
+        return True
+
+    def ending_execution(self, entity: Any) -> None:
+        """Nothing to release."""
+
+
+class MutuallyExclusiveCallbackGroup(CallbackGroup):
+    """At most one of its callbacks runs at any time."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._active: Any = None
+        self._lock = threading.Lock()
+
+    def can_execute(self, entity: Any) -> bool:
+        """Whether none of the group's callbacks is running."""
+        return self._active is None
+
+    def beginning_execution(self, entity: Any) -> bool:
+        """Take the group for ``entity`` if it is free."""
+        with self._lock:
+            if self._active is None:
+                self._active = entity
+                return True
+            return False
+
+    def ending_execution(self, entity: Any) -> None:
+        """Free the group."""
+        with self._lock:
+            if self._active is entity:
+                self._active = None
+
+
+class Executable:
+    """What executors need of an entity (subscription, timer, service, client, guard, waitable).
+
+    ``_ready()`` says whether it has work; ``_take()`` takes one piece of it and returns the
+    call that does it (None: nothing to do after all). ``_executor_event`` is set while an
+    executor's handler for it is on its way, so it is not offered twice.
+    """
+
+    callback_group: CallbackGroup | None = None
+    _executor_event = False
+    _ungrouped = False  # taken whatever its group is doing (clients: completing a future)
+    _is_timer = False
+    _what = "callback"  # how an exception in its callback is introduced
+
+    def _ready(self) -> bool:
+        raise NotImplementedError
+
+    def _take(self) -> Callable[[], Any] | None:
+        raise NotImplementedError
+
+
+class Queued(Executable):
+    """An entity whose work is deliveries waiting in its ``_queue`` (filled by ``deliver``)."""
+
+    _queue: deque[Delivery]
+
+    def _ready(self) -> bool:
+        return bool(self._queue)
+
+    def _pop(self) -> Delivery | None:
+        """The oldest queued delivery (None: another thread took it)."""
+        try:
+            return self._queue.popleft()
+        except IndexError:
+            return None
+
+
+__all__ = [
+    "CallbackGroup",
+    "Executable",
+    "MutuallyExclusiveCallbackGroup",
+    "Queued",
+    "ReentrantCallbackGroup",
+]
