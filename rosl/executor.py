@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.node.task import Future, Task
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Coroutine, Generator, Iterable
+    from collections.abc import Callable, Coroutine, Iterable
     from types import TracebackType
 
     from rosl.node.context import Context
@@ -79,18 +79,19 @@ class Executor:
         from rosl.node.context import default_context
 
         self._context = context or default_context
-        self._nodes: list[Node] = []
+        self._nodes: tuple[Node, ...] = ()  # replaced, never changed in place: read lock-free
         self._nodes_lock = threading.RLock()
         self._ready_tasks: deque[Task[Any]] = deque()
         self._tasks_lock = threading.Lock()
         self._is_shutdown = False
-        self._cb_iter: Generator[Ready, None, None] | None = None
-        self._last_args: tuple[Any, ...] | None = None
-        self._last_kwargs: dict[str, Any] | None = None
+        self._batch: deque[tuple[Any, Node | None]] = deque()  # found ready, not handed out
+        self._turn = 0  # rotates the order of what one look finds (see _collect)
+        self._rotate = False  # only with threads: one thread runs a whole look in order
+        self._waiting_on: tuple[tuple[Node, ...], Callable[[], bool] | None] = ((), None)
         self._timers_ran = 0  # timer callbacks since the last lock-step answer
         self.answers_lockstep = True  # rosl: answer lock-stepped simulators when idle
-        self._work = 0  # handlers running (shutdown waits for them)
-        self._work_done = threading.Condition()
+        self._work = 0  # callbacks running (shutdown waits for them)
+        self._work_lock = threading.Lock()
 
     @property
     def context(self) -> Context:
@@ -104,7 +105,7 @@ class Executor:
         with self._nodes_lock:
             if node in self._nodes:
                 return False
-            self._nodes.append(node)
+            self._nodes = (*self._nodes, node)
         node.executor = self
         self.wake()
         return True
@@ -114,15 +115,14 @@ class Executor:
         with self._nodes_lock:
             if node not in self._nodes:
                 return
-            self._nodes.remove(node)
+            self._nodes = tuple(n for n in self._nodes if n is not node)
         if node.executor is self:
             node.executor = None
         self.wake()
 
     def get_nodes(self) -> list[Node]:
         """The nodes this executor runs."""
-        with self._nodes_lock:
-            return list(self._nodes)
+        return list(self._nodes)
 
     def create_task(self, callback: Callable[..., Any], *args: Any, **kwargs: Any) -> Task[Any]:
         """Run ``callback(*args, **kwargs)`` (a function or a coroutine function) while spinning."""
@@ -149,15 +149,17 @@ class Executor:
         """Stop spinning and wait for running callbacks; False if they outlast the timeout."""
         self._is_shutdown = True
         self.wake()
-        wait = None if timeout_sec is None or timeout_sec < 0 else timeout_sec
-        with self._work_done:
-            finished = self._work_done.wait_for(lambda: self._work == 0, wait)
+        forever = timeout_sec is None or timeout_sec < 0
+        deadline = time.monotonic() + (0.0 if forever else (timeout_sec or 0.0))
+        while self._work and (forever or time.monotonic() < deadline):
+            time.sleep(0.005)
+        finished = self._work == 0
         with self._nodes_lock:
-            for node in list(self._nodes):
+            nodes, self._nodes = self._nodes, ()
+            for node in nodes:
                 if node.executor is self:
                     node.executor = None
-            self._nodes.clear()
-        self._cb_iter = None
+        self._batch.clear()
         return finished
 
     def __enter__(self) -> Executor:
@@ -186,11 +188,17 @@ class Executor:
 
         ``timeout_sec`` None or negative waits without limit; 0 does not wait.
         """
-        try:
-            handler, _, _ = self.wait_for_ready_callbacks(timeout_sec=timeout_sec)
-        except _STOPS:
-            return
-        self._run_handler(handler)
+        forever = timeout_sec is None or timeout_sec < 0
+        deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
+        while True:
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+            try:
+                item, node = self._next_work(remaining)
+            except _STOPS:
+                return
+            self._run(item, node)
+            if not item._internal:
+                return  # rosl's own housekeeping does not count as the one callback
 
     def spin_some(self, timeout_sec: float = 0.0) -> int:
         """Run every callback ready now, waiting up to ``timeout_sec`` for the first; how many.
@@ -201,14 +209,11 @@ class Executor:
         wait: float | None = timeout_sec
         while True:
             try:
-                handler, _, _ = self.wait_for_ready_callbacks(timeout_sec=wait)
+                item, node = self._next_work(wait)
             except _STOPS:
                 return ran
-            handler()
+            self._run(item, node)
             ran += 1
-            error = handler.exception()
-            if error is not None:
-                raise error
             wait = 0.0
 
     def spin_until_future_complete(
@@ -233,26 +238,39 @@ class Executor:
 
     def _spin_once_until(self, future: Future[Any], timeout_sec: float | None) -> None:
         try:
-            handler, _, _ = self.wait_for_ready_callbacks(timeout_sec, None, future.done)
+            item, node = self._next_work(timeout_sec, None, future.done)
         except _STOPS:
             return
-        self._run_handler(handler)
+        self._run(item, node)
 
-    def _run_handler(self, handler: Task[Any]) -> None:
-        """Run one handler as :meth:`spin_once` does (a subclass may hand it to a thread)."""
-        handler()
-        error = handler.exception()
-        if error is not None:
-            raise error
+    def _run(self, item: Any, node: Node | None) -> None:
+        """Run a task step or an entity's callback on this thread (subclasses may not)."""
+        if isinstance(item, Task):
+            item()
+            error = item.exception()
+            if error is not None:
+                raise error
+            return
+        assert node is not None
+        result = self._execute(item, node)
+        if inspect.iscoroutine(result):  # a coroutine callback: go on as a task
+            task: Task[Any] = Task(_given, (result,), executor=self)
+            task.entity, task.node = item, node
+            task()
 
     # --- waiting for work --------------------------------------------------------------------
 
-    def wait_for_ready_callbacks(self, *args: Any, **kwargs: Any) -> Ready:
-        """The next (handler, entity, node) to run; waits for one.
+    def wait_for_ready_callbacks(
+        self,
+        timeout_sec: float | None = None,
+        nodes: Iterable[Node] | None = None,
+        condition: Callable[[], bool] | None = None,
+    ) -> Ready:
+        """The next (handler, entity, node) to run, waiting up to ``timeout_sec`` for one.
 
-        Arguments (``timeout_sec=None, nodes=None, condition=None``) go to the generator that
-        finds ready callbacks; calls with the same arguments go on with the same generator,
-        so one wait serves several callbacks.
+        The handler is a :class:`Task`: calling it takes the entity's data and runs its
+        callback. One look at the nodes finds every ready entity; later calls hand them out
+        before looking again.
 
         Raises:
             TimeoutException: nothing became ready within ``timeout_sec``.
@@ -260,63 +278,66 @@ class Executor:
             ExternalShutdownException: the context was shut down.
             ConditionReachedException: ``condition()`` became true.
         """
-        while True:
-            if self._cb_iter is None or self._last_args != args or self._last_kwargs != kwargs:
-                self._last_args, self._last_kwargs = args, kwargs
-                self._cb_iter = self._wait_for_ready_callbacks(*args, **kwargs)
-            try:
-                return next(self._cb_iter)
-            except StopIteration:
-                self._cb_iter = None
-            except BaseException:
-                self._cb_iter = None
-                raise
+        item, node = self._next_work(timeout_sec, nodes, condition)
+        if isinstance(item, Task):
+            return Ready((item, item.entity, node))
+        assert node is not None
+        handler: Task[Any] = Task(self._execute, (item, node), executor=self)
+        handler.entity, handler.node = item, node
+        return Ready((handler, item, node))
 
     def can_execute(self, entity: Any) -> bool:
         """Whether ``entity``'s callback may be offered now (not in flight; its group agrees)."""
         if entity._executor_event:
             return False
         group = entity.callback_group
-        return group is None or bool(group.can_execute(entity))
+        return group is None or entity._ungrouped or bool(group.can_execute(entity))
 
-    def _wait_for_ready_callbacks(
+    def _next_work(
         self,
-        timeout_sec: float | None = None,
+        timeout_sec: float | None,
         nodes: Iterable[Node] | None = None,
         condition: Callable[[], bool] | None = None,
-    ) -> Generator[Ready, None, None]:
+    ) -> tuple[Any, Node | None]:
+        """The next task to resume, or entity to run (marked in flight); waits for one."""
         deadline = (
             None if timeout_sec is None or timeout_sec < 0 else time.monotonic() + timeout_sec
         )
-        yielded = False
+        only = None if nodes is None else tuple(nodes)
+        batch = self._batch
+        context = self._context
         waited = False
-        while not yielded:
-            participant = self._participant()
+        while True:
+            if self._is_shutdown:
+                raise ShutdownException
+            if not context.ok():
+                raise ExternalShutdownException
+            if condition is not None and condition():
+                raise ConditionReachedException
+            while batch:
+                item, node = batch.popleft()
+                if only is not None and node is not None and node not in only:
+                    if isinstance(item, Task):
+                        self._schedule(item)  # for another call
+                    continue
+                if isinstance(item, Task):
+                    if not item.done():
+                        return item, node
+                elif self.can_execute(item) and item._ready():
+                    item._executor_event = True  # not offered again until taken
+                    return item, node
+            participant = context.participant
+            if participant is not None and participant.closed:
+                participant = None
             changes = None if participant is None else participant.changes
-            chosen = self.get_nodes() if nodes is None else list(nodes)
-            self._check_stop(condition)
-            work = self._collect(chosen)
-            for task_or_entity, node in work:
-                if isinstance(task_or_entity, Task):
-                    if task_or_entity.done():
-                        continue
-                    yielded = True
-                    yield Ready((task_or_entity, task_or_entity.entity, node))
-                elif (
-                    node is not None
-                    and self.can_execute(task_or_entity)
-                    and task_or_entity._ready()
-                ):
-                    yielded = True
-                    yield Ready((self._make_handler(task_or_entity, node), task_or_entity, node))
-            if yielded:
-                return
-            if work:
-                continue  # what looked ready was taken meanwhile (another thread): look again
+            chosen = self._nodes if only is None else only
+            if self._collect(chosen, batch):
+                continue
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None and remaining <= 0 and waited:
                 raise TimeoutException
-            self._answer_lockstep(participant, chosen)
+            if participant is not None and self.answers_lockstep:
+                self._answer_lockstep(participant, chosen)
             wait = self._next_timer(chosen)
             if remaining is not None:
                 wait = max(0.0, remaining) if wait is None else min(wait, max(0.0, remaining))
@@ -324,58 +345,61 @@ class Executor:
             if participant is None:
                 time.sleep(0.05 if wait is None else min(wait, 0.05))
                 continue
+            self._waiting_on = (chosen, condition)
+            participant.wait(self._wait_ready, wait, changes)
 
-            def ready(nodes_: list[Node] = chosen) -> bool:
-                return (
-                    not self._running()
-                    or bool(self._ready_tasks)
-                    or (condition is not None and condition())
-                    or self._any_ready(nodes_)
-                )
+    def _wait_ready(self) -> bool:
+        """Whether the wait in :meth:`_next_work` may end (asked at its deadline)."""
+        nodes, condition = self._waiting_on
+        return (
+            not self._running()
+            or bool(self._ready_tasks)
+            or (condition is not None and condition())
+            or self._collect(nodes, None)
+        )
 
-            participant.wait(ready, wait, changes)
+    def _collect(
+        self, nodes: tuple[Node, ...], into: deque[tuple[Any, Node | None]] | None
+    ) -> bool:
+        """Queue in ``into`` the tasks to resume and the entities whose callback could run.
 
-    def _check_stop(self, condition: Callable[[], bool] | None) -> None:
-        if self._is_shutdown:
-            raise ShutdownException
-        if not self._context.ok():
-            raise ExternalShutdownException
-        if condition is not None and condition():
-            raise ConditionReachedException
-
-    def _participant(self) -> Participant | None:
-        participant = self._context.participant
-        return None if participant is None or participant.closed else participant
-
-    def _collect(self, nodes: list[Node]) -> list[tuple[Any, Node | None]]:
-        """Tasks to resume and entities whose callback could run, in rclpy's order per node."""
-        work: list[tuple[Any, Node | None]] = []
+        Entities come in rclpy's order per node. With ``into`` None, only say whether there
+        are any.
+        """
+        found = False
         if self._ready_tasks:
+            if into is None:
+                return True
             with self._tasks_lock:
                 tasks, self._ready_tasks = self._ready_tasks, deque()
             for task in tasks:
                 node = task.node
                 if node is None or node in nodes:
-                    work.append((task, node))
+                    into.append((task, node))
+                    found = True
                 else:
                     with self._tasks_lock:
                         self._ready_tasks.append(task)
-        can_execute = self.can_execute
+        ready: list[tuple[Any, Node | None]] = []
         for node in nodes:
             for entity in node._entities():
-                if not entity._executor_event and entity._ready() and can_execute(entity):
-                    work.append((entity, node))
-        return work
+                if entity._executor_event or not entity._ready():
+                    continue
+                group = entity.callback_group
+                if group is None or entity._ungrouped or group.can_execute(entity):
+                    if into is None:
+                        return True
+                    ready.append((entity, node))
+        if self._rotate and len(ready) > 1:  # threads: start each look one further, so when
+            # a busy group lets only one of them run, the others get their turn
+            self._turn = turn = (self._turn + 1) % len(ready)
+            ready = ready[turn:] + ready[:turn]
+        if ready and into is not None:
+            into.extend(ready)
+            found = True
+        return found
 
-    def _any_ready(self, nodes: list[Node]) -> bool:
-        can_execute = self.can_execute
-        for node in nodes:
-            for entity in node._entities():
-                if not entity._executor_event and entity._ready() and can_execute(entity):
-                    return True
-        return False
-
-    def _next_timer(self, nodes: list[Node]) -> float | None:
+    def _next_timer(self, nodes: tuple[Node, ...]) -> float | None:
         """Seconds until the next wall-time timer of these nodes that could run is due."""
         soonest: float | None = None
         for node in nodes:
@@ -390,20 +414,13 @@ class Executor:
 
     # --- running one callback ----------------------------------------------------------------
 
-    def _make_handler(self, entity: Any, node: Node) -> Task[Any]:
-        """The task that takes ``entity``'s data and runs its callback (once)."""
-        entity._executor_event = True  # not offered again until taken
-        handler: Task[Any] = Task(self._execute, (entity, node), executor=self)
-        handler.entity, handler.node = entity, node
-        return handler
-
     def _execute(self, entity: Any, node: Node) -> Any:
         group = None if entity._ungrouped else entity.callback_group
         if self._is_shutdown or (group is not None and not group.beginning_execution(entity)):
             entity._executor_event = False
             self.wake()
             return None
-        with self._work_done:
+        with self._work_lock:
             self._work += 1
         try:
             work = entity._take()
@@ -444,29 +461,24 @@ class Executor:
     def _end(self, entity: Any, group: Any) -> None:
         if group is not None:
             group.ending_execution(entity)
-        with self._work_done:
+        with self._work_lock:
             self._work -= 1
-            if self._work <= 0:
-                self._work = 0
-                self._work_done.notify_all()
         self.wake()  # a mutually exclusive group is free again
 
     # --- lock-step ---------------------------------------------------------------------------
 
-    def _answer_lockstep(self, participant: Participant | None, nodes: list[Node]) -> None:
+    def _answer_lockstep(self, participant: Participant, nodes: tuple[Node, ...]) -> None:
         """Before waiting: answer a lock-stepped simulator whose messages were handled.
 
         The answer follows the timers the new ``/clock`` made due (see
         :mod:`rosl.node.lockstep`).
         """
-        if participant is None or not self.answers_lockstep:
-            return
         answerer = participant.answerer or participant.answer_lockstep()
         if answerer.seen:
             answerer.answer(self._next_sim_wakeup(nodes), self._timers_ran > 0)
             self._timers_ran = 0
 
-    def _next_sim_wakeup(self, nodes: list[Node]) -> int:
+    def _next_sim_wakeup(self, nodes: tuple[Node, ...]) -> int:
         """The earliest sim-time timer deadline (ns), -1 when no sim-time timer is armed."""
         soonest = -1
         for node in nodes:
@@ -475,6 +487,10 @@ class Executor:
                     due = timer.clock.now_ns() + (timer.time_until_next_call() or 0)
                     soonest = due if soonest < 0 else min(soonest, due)
         return soonest
+
+
+def _given(value: Any) -> Any:
+    return value
 
 
 class SingleThreadedExecutor(Executor):
@@ -498,11 +514,18 @@ class MultiThreadedExecutor(Executor):
     def __init__(self, num_threads: int | None = None, *, context: Context | None = None) -> None:
         super().__init__(context=context)
         self.num_threads = num_threads or _default_threads()
+        self._rotate = True
         self._pool = ThreadPoolExecutor(self.num_threads, thread_name_prefix="rosl-executor")
         self._handlers: list[Task[Any]] = []
         self._handlers_lock = threading.Lock()
 
-    def _run_handler(self, handler: Task[Any]) -> None:
+    def _run(self, item: Any, node: Node | None) -> None:
+        if isinstance(item, Task):
+            handler = item
+        else:
+            assert node is not None
+            handler = Task(self._execute, (item, node), executor=self)
+            handler.entity, handler.node = item, node
         handler.add_done_callback(lambda _: self.wake())
         self._pool.submit(handler)
         with self._handlers_lock:

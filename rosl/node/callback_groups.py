@@ -100,6 +100,7 @@ class Executable:
     _executor_event = False
     _ungrouped = False  # taken whatever its group is doing (clients: completing a future)
     _is_timer = False
+    _internal = False  # rosl's housekeeping (spin_once goes on to a callback of the user's)
     _what = "callback"  # how an exception in its callback is introduced
 
     def _ready(self) -> bool:

@@ -123,6 +123,7 @@ class Node:
             self._parameter_services = ParameterServices(self, self._parameters)
         self.participant.discovery.changed()
         self._name_check = self.create_timer(0.5, self._check_duplicate_name)
+        self._name_check._internal = True
 
     # --- names -------------------------------------------------------------------------------
 

@@ -191,27 +191,30 @@ class Participant:
 
         Meanwhile the receiver is polled by one waiting thread at a time (the others sleep
         until it has dispatched): a single-threaded executor reads its own deliveries, with
-        no thread hand-off. ``ready`` is called again after each dispatch and wake-up.
-        With ``since`` (a :attr:`changes` value read before the caller chose ``timeout``),
-        it returns as soon as anything notified since then.
+        no thread hand-off. With ``since`` (a :attr:`changes` value read before the caller
+        looked for work), it returns True as soon as anything changed since then — a
+        dispatch or a :meth:`notify` — and leaves the looking to the caller.
         """
         deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
         first = True
+
+        def done() -> bool:
+            return self.changes != since if since is not None else ready()
+
         while True:
-            if ready() or (since is not None and self.changes != since):
-                return ready()
+            if done():
+                return True
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None:
                 if remaining <= 0 and not first:
-                    return False
+                    return ready()
                 remaining = max(0.0, remaining)
             first = False
             if not self.closed and self._poll_lock.acquire(blocking=False):
                 try:
                     self._poller = threading.get_ident()
-                    # checked after claiming the poll: a notify from now on wakes us
-                    if ready() or (since is not None and self.changes != since):
-                        return ready()
+                    if done():  # checked after claiming the poll: a notify from now on wakes us
+                        return True
                     self._poll_locked(remaining, None)
                 finally:
                     self._poller = None
@@ -223,8 +226,8 @@ class Participant:
             with self._cond:
                 self._waiting += 1
                 try:
-                    if ready() or (since is not None and self.changes != since):
-                        return ready()
+                    if done():
+                        return True
                     self._cond.wait(remaining if remaining is not None or not self.closed else 0.1)
                 finally:
                     self._waiting -= 1
@@ -265,6 +268,8 @@ class Participant:
                 sink(delivery)
             else:
                 self.dispatch(delivery)
+        if deliveries:
+            self.changes += 1  # queues filled: waiters look again
         return len(deliveries)
 
     def dispatch(self, delivery: Delivery) -> None:

@@ -30,7 +30,8 @@ class Future(Generic[T]):
     """The result of an asynchronous operation (rclpy.task.Future)."""
 
     def __init__(self, *, executor: Any = None) -> None:
-        self._done = threading.Event()
+        self._done = False
+        self._event: threading.Event | None = None  # made by the first wait()
         self._result: T | None = None
         self._exception: BaseException | None = None
         self._cancelled = False
@@ -39,13 +40,13 @@ class Future(Generic[T]):
         self._executor = executor
 
     def __await__(self) -> Generator[Future[T], None, T | None]:
-        while not self._done.is_set():
+        while not self._done:
             yield self  # the task running the coroutine resumes when this future is done
         return self.result()
 
     def done(self) -> bool:
         """Whether a result, an exception or a cancellation is set."""
-        return self._done.is_set()
+        return self._done
 
     def cancelled(self) -> bool:
         """Whether the future was cancelled."""
@@ -54,7 +55,7 @@ class Future(Generic[T]):
     def cancel(self) -> None:
         """Cancel the future (no effect once done)."""
         with self._lock:
-            if self._done.is_set():
+            if self._done:
                 return
             self._cancelled = True
         self._finish()
@@ -86,7 +87,7 @@ class Future(Generic[T]):
     def add_done_callback(self, callback: Callable[[Future[T]], None]) -> None:
         """Call ``callback(future)`` when done (at once if already done)."""
         with self._lock:
-            if not self._done.is_set():
+            if not self._done:
                 self._callbacks.append(callback)
                 return
         callback(self)
@@ -101,12 +102,21 @@ class Future(Generic[T]):
 
     def wait(self, timeout: float | None = None) -> bool:
         """Block until done (for threads that do not spin); return whether it is done."""
-        return self._done.wait(timeout)
+        with self._lock:
+            if self._done:
+                return True
+            if self._event is None:
+                self._event = threading.Event()
+            event = self._event
+        return event.wait(timeout)
 
     def _finish(self) -> None:
         with self._lock:
-            self._done.set()
+            self._done = True
             callbacks, self._callbacks = self._callbacks, []
+            event = self._event
+        if event is not None:
+            event.set()
         for callback in callbacks:
             try:
                 callback(self)
@@ -135,6 +145,7 @@ class Task(Future[T]):
         self._coroutine: Coroutine[Any, Any, Any] | None = None
         self._executing = False
         self._task_lock = threading.Lock()
+        self._internal = False  # (a task is never rosl's housekeeping)
         self.entity: Any = None  # what an executor's handler task serves, and its node
         self.node: Any = None
 
@@ -144,11 +155,11 @@ class Task(Future[T]):
 
     def __call__(self) -> None:
         """Run the task, or resume it, until it completes or waits for a future."""
-        if self._done.is_set():
+        if self._done:
             return
         # a step on another thread ends soon (at its next await); then this one runs
         with self._task_lock:
-            if self._done.is_set():
+            if self._done:
                 return
             self._executing = True
             try:
@@ -187,5 +198,5 @@ class Task(Future[T]):
 
     def _resume(self, _: object) -> None:
         executor = self._executor
-        if executor is not None and not self._done.is_set():
+        if executor is not None and not self._done:
             executor._schedule(self)

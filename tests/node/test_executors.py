@@ -1,0 +1,1011 @@
+"""Executors run the callbacks of their own nodes, as rclpy's do.
+
+Real nodes on the test's domain over loopback: which executor runs which node's callbacks,
+one callback per ``spin_once``, callback groups (mutually exclusive, reentrant, custom),
+thread pools, custom executors written against rclpy's API, coroutine callbacks, guard
+conditions and waitables, keep-last queues, shutdown and removal. Every wait is bounded;
+the assertions are guarantees (counts, order, never-concurrent), never speeds.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+from rosl.executor import (
+    Executor,
+    MultiThreadedExecutor,
+    ShutdownException,
+    SingleThreadedExecutor,
+    TimeoutException,
+)
+from rosl.node.callback_groups import (
+    CallbackGroup,
+    MutuallyExclusiveCallbackGroup,
+    ReentrantCallbackGroup,
+)
+from rosl.node.task import Future
+from rosl.node.waitable import Waitable
+from tests.conftest import wait_until
+from tests.node.helpers import snippet
+from tests.node.test_rclpy_compat import RUN_AS_RCLPY
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+BOUND = 20.0  # seconds: only a broken executor takes this long
+
+
+def spin_until(executor: Executor, predicate: Callable[[], bool], timeout: float = BOUND) -> bool:
+    """Spin ``executor`` on this thread until ``predicate()`` or the (bounded) deadline."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() >= deadline:
+            return predicate()
+        executor.spin_once(timeout_sec=0.05)
+    return True
+
+
+def settle(executor: Executor, node: Any, startup: list[Any]) -> None:
+    """Spin until the timers the node had when created (``startup``) are gone.
+
+    A rosl node checks once, shortly after it is created, that its name is unique (a timer
+    that destroys itself); tests that count every callback an executor runs let it finish
+    first.
+    """
+    assert spin_until(executor, lambda: not any(t in node.timers for t in startup)), node.timers
+
+
+def settled(ros: Any, name: str) -> tuple[Any, SingleThreadedExecutor]:
+    """A new node in its own executor, spun past its start-up timers."""
+    node = ros.Node(name)
+    startup = list(node.timers)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    settle(executor, node, startup)
+    return node, executor
+
+
+class Background:
+    """Spins an executor on its own thread; ``stop`` shuts it down and joins (bounded)."""
+
+    def __init__(self, executor: Executor) -> None:
+        self.executor = executor
+        self.error: BaseException | None = None
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        try:
+            with contextlib.suppress(ShutdownException):  # custom executors may let it out
+                self.executor.spin()
+        except BaseException as err:  # reported by stop()
+            self.error = err
+
+    def stop(self) -> None:
+        self.executor.shutdown(timeout_sec=BOUND)
+        self.thread.join(BOUND)
+        assert not self.thread.is_alive(), "spin() did not return after shutdown()"
+        if self.error is not None:
+            raise self.error
+
+
+def _adder(request: Any, response: Any) -> Any:
+    response.sum = request.a + request.b
+    return response
+
+
+def _start_script(spawn: Any, tmp_path: Any, source: str, *args: str) -> Any:
+    script = tmp_path / "script.py"
+    script.write_text(snippet(source))
+    return spawn(RUN_AS_RCLPY, str(script), *args)
+
+
+# --- 1. an executor runs its own nodes only --------------------------------------------------
+
+
+def test_an_executor_runs_only_the_subscriptions_timers_and_services_of_its_nodes(ros):
+    from example_interfaces.srv import AddTwoInts
+    from std_msgs.msg import Int32
+
+    a, b = ros.Node("node_a"), ros.Node("node_b")
+    heard: dict[str, list[int]] = {"a": [], "b": []}
+    a.create_subscription(Int32, "shared", lambda m: heard["a"].append(m.data), 10)
+    sub_b = b.create_subscription(Int32, "shared", lambda m: heard["b"].append(m.data), 10)
+    ticks = {"a": 0, "b": 0}
+    a.create_timer(0.01, lambda: ticks.__setitem__("a", ticks["a"] + 1))
+    b.create_timer(0.01, lambda: ticks.__setitem__("b", ticks["b"] + 1))
+
+    service = b.create_service(AddTwoInts, "only_b_adds", _adder)
+    client = a.create_client(AddTwoInts, "only_b_adds")
+    talker = ros.Node("talker")
+    pub = talker.create_publisher(Int32, "shared", 10)
+    executor_a, executor_b = SingleThreadedExecutor(), SingleThreadedExecutor()
+    executor_a.add_node(a)
+    executor_b.add_node(b)
+    assert (a.executor, b.executor, talker.executor) == (executor_a, executor_b, None)
+
+    for n in range(5):
+        pub.publish(Int32(data=n))
+    assert spin_until(executor_a, lambda: len(heard["a"]) == 5 and ticks["a"] >= 5), heard
+    assert heard["b"] == []  # a's executor read b's messages off the socket but did not run them
+    assert len(sub_b._queue) == 5
+    assert ticks["b"] == 0
+
+    assert client.wait_for_service(timeout_sec=BOUND)
+    answer = client.call_async(AddTwoInts.Request(a=2, b=40))
+    assert spin_until(executor_a, lambda: len(service._queue) == 1), "the request never arrived"
+    assert not answer.done()
+    assert service.handled == 0
+
+    assert spin_until(
+        executor_b, lambda: service.handled == 1 and len(heard["b"]) == 5 and ticks["b"] >= 1
+    )
+    assert heard["b"] == [0, 1, 2, 3, 4]
+    assert not answer.done()  # the client is a's: its response waits for a's executor
+    assert spin_until(executor_a, answer.done)
+    assert answer.result().sum == 42
+    assert heard["a"] == [0, 1, 2, 3, 4]
+
+
+# --- 2. spin_once runs exactly one callback --------------------------------------------------
+
+
+def test_each_spin_once_runs_exactly_one_callback_when_several_are_ready(ros):
+    from std_msgs.msg import Int32
+
+    node, executor = settled(ros, "one_at_a_time")
+    ran: list[str] = []
+    node.create_timer(0.001, lambda: ran.append("fast"))
+    node.create_timer(0.002, lambda: ran.append("faster"))
+    node.create_subscription(Int32, "plenty", lambda m: ran.append(f"msg {m.data}"), 100)
+    pub = node.create_publisher(Int32, "plenty", 100)
+    for n in range(20):
+        pub.publish(Int32(data=n))
+    time.sleep(0.05)  # lets both timers fall due; the check below holds whatever happens
+
+    for call in range(1, 41):
+        before = len(ran)
+        executor.spin_once(timeout_sec=None)
+        assert len(ran) == before + 1, f"spin_once call {call} ran {ran[before:]}"
+    assert any(r.startswith("msg") for r in ran)
+    assert {"fast", "faster"} <= set(ran)
+
+
+def test_spin_once_with_a_timeout_and_nothing_ready_returns_without_running_anything(ros):
+    from std_msgs.msg import Int32
+
+    node, executor = settled(ros, "idle")
+    ran: list[str] = []
+    node.create_timer(3600.0, lambda: ran.append("timer"))
+    node.create_subscription(Int32, "silence", lambda m: ran.append("message"), 10)
+
+    returned = threading.Event()
+
+    def once() -> None:
+        executor.spin_once(timeout_sec=0.2)
+        returned.set()
+
+    worker = threading.Thread(target=once, daemon=True)
+    worker.start()
+    worker.join(30.0)
+    assert returned.is_set(), "spin_once(timeout_sec=0.2) did not return"
+    assert ran == []
+    with pytest.raises(TimeoutException):
+        executor.wait_for_ready_callbacks(timeout_sec=0.2)
+    assert ran == []
+
+
+CYCLE_TALKER = """
+import time
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from std_msgs.msg import Int32
+
+
+def main():
+    rclpy.init()
+    node = Node("cycle_talker")
+    pub = node.create_publisher(Int32, "cycles", 10)
+    sent = []
+
+    def tick():
+        sent.append(len(sent) + 1)
+        pub.publish(Int32(data=sent[-1]))
+
+    node.create_timer(0.6, tick)  # talker_qos ticks once a second: a slow timer
+    deadline = time.monotonic() + 20
+    while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    count = 0
+    while count < 8:
+        executor.spin_once()
+        count += 1
+    print(f"published {len(sent)}", flush=True)
+    executor.shutdown()
+    node.destroy_node()
+    rclpy.shutdown()
+
+
+main()
+"""
+
+
+def test_a_talker_looping_over_spin_once_publishes_once_per_cycle(ros, spawn, tmp_path):
+    from std_msgs.msg import Int32
+
+    listener = ros.Node("cycle_listener")
+    got: list[int] = []
+    listener.create_subscription(Int32, "cycles", lambda m: got.append(m.data), 100)
+    executor = SingleThreadedExecutor()
+    executor.add_node(listener)
+    spinner = Background(executor)
+    child = _start_script(spawn, tmp_path, CYCLE_TALKER)
+
+    def graph_noise() -> None:  # nodes come and go while the talker spins: discovery traffic
+        deadline = time.monotonic() + 40.0
+        for n in range(10**6):
+            if child.popen.poll() is not None or time.monotonic() > deadline:
+                return
+            passer = ros.Node(f"passer_{n}")
+            passer.create_publisher(Int32, "noise", 10).publish(Int32(data=n))
+            time.sleep(0.05)
+            passer.destroy_node()
+
+    noise = threading.Thread(target=graph_noise, daemon=True)
+    noise.start()
+    try:
+        out, err = child.finish(timeout=40.0)
+        noise.join(BOUND)
+        assert child.returncode == 0, err
+        assert out.strip().splitlines()[-1] == "published 8", out
+        assert wait_until(lambda: len(got) >= 8, BOUND), (got, out)
+        time.sleep(0.3)  # a ninth message, were there one, is already on its way
+    finally:
+        spinner.stop()
+    assert got == [1, 2, 3, 4, 5, 6, 7, 8]
+
+
+# --- 3. and 4. callback groups under a thread pool -------------------------------------------
+
+
+class Concurrency:
+    """Counts how many tracked callbacks run at once, and how often each ran."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.active = 0
+        self.most = 0
+        self.runs: dict[str, int] = {}
+        self.threads: set[str] = set()
+
+    def enter(self, name: str) -> None:
+        with self.lock:
+            self.active += 1
+            self.most = max(self.most, self.active)
+            self.runs[name] = self.runs.get(name, 0) + 1
+            self.threads.add(threading.current_thread().name)
+
+    def leave(self) -> None:
+        with self.lock:
+            self.active -= 1
+
+    def tracked(self, name: str, pause: float) -> Callable[..., None]:
+        def callback(*_: Any) -> None:
+            self.enter(name)
+            try:
+                time.sleep(pause)
+            finally:
+                self.leave()
+
+        return callback
+
+
+def test_a_mutually_exclusive_group_never_runs_two_callbacks_at_once_on_four_threads(ros):
+    from std_msgs.msg import Int32
+
+    node = ros.Node("exclusive")
+    group = MutuallyExclusiveCallbackGroup()
+    seen = Concurrency()
+    names = ["timer 1", "timer 2", "timer 3", "sub 1", "sub 2"]
+    # the timers fall due together, and the work fits the period: nothing is starved
+    for name in names[:3]:
+        node.create_timer(0.03, seen.tracked(name, 0.003), callback_group=group)
+    for n, name in enumerate(names[3:], 1):
+        node.create_subscription(
+            Int32, f"busy_{n}", seen.tracked(name, 0.003), 10, callback_group=group
+        )
+    feeder = ros.Node("feeder")
+    pubs = [feeder.create_publisher(Int32, f"busy_{n}", 10) for n in (1, 2)]
+    feeder.create_timer(0.03, lambda: [p.publish(Int32(data=1)) for p in pubs])
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    executor.add_node(feeder)
+    spinner = Background(executor)
+    try:
+        done = wait_until(lambda: all(seen.runs.get(n, 0) >= 5 for n in names), BOUND)
+    finally:
+        spinner.stop()
+    assert done, seen.runs
+    assert seen.most == 1, f"{seen.most} callbacks of one mutually exclusive group ran at once"
+
+
+def test_busy_timers_of_one_exclusive_group_take_turns_on_four_threads(ros):
+    # each callback outlasts every period, so all three are always due when the group frees:
+    # looking in the same order each time would run only the first one
+    node = ros.Node("turns")
+    group = MutuallyExclusiveCallbackGroup()
+    seen = Concurrency()
+    names = ["timer 1", "timer 2", "timer 3"]
+    for name in names:
+        node.create_timer(0.005, seen.tracked(name, 0.02), callback_group=group)
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    spinner = Background(executor)
+    try:
+        done = wait_until(lambda: sum(seen.runs.get(n, 0) for n in names) >= 30, BOUND)
+    finally:
+        spinner.stop()
+    assert done, seen.runs
+    assert all(seen.runs.get(n, 0) >= 5 for n in names), f"a timer was starved: {seen.runs}"
+    assert seen.most == 1
+
+
+N = 4
+
+
+def _barrier_callbacks(
+    node: Any, group: CallbackGroup, barrier: threading.Barrier, seen: Concurrency
+) -> tuple[list[Any], list[str]]:
+    outcomes: list[str] = []
+
+    def make(n: int) -> Callable[[], None]:
+        def callback() -> None:
+            seen.enter(f"guard {n}")
+            try:
+                barrier.wait()
+                outcomes.append("passed")
+            except threading.BrokenBarrierError:
+                outcomes.append("broken")
+            finally:
+                seen.leave()
+
+        return callback
+
+    guards = [node.create_guard_condition(make(n), group) for n in range(N)]
+    return guards, outcomes
+
+
+def test_a_reentrant_group_runs_n_callbacks_at_once_on_n_threads(ros):
+    node = ros.Node("reentrant")
+    barrier = threading.Barrier(N, timeout=30.0)  # passes only when N callbacks wait at once
+    seen = Concurrency()
+    guards, outcomes = _barrier_callbacks(node, ReentrantCallbackGroup(), barrier, seen)
+    executor = MultiThreadedExecutor(num_threads=N)
+    executor.add_node(node)
+    spinner = Background(executor)
+    try:
+        for guard in guards:
+            guard.trigger()
+        assert wait_until(lambda: len(outcomes) == N, 40.0), outcomes
+    finally:
+        spinner.stop()
+    assert outcomes == ["passed"] * N
+    assert seen.most == N
+    assert len(seen.threads) == N
+
+
+def test_a_pool_of_fewer_threads_never_runs_more_callbacks_at_once(ros):
+    node = ros.Node("short_handed")
+    barrier = threading.Barrier(N, timeout=3.0)  # needs N at once: N - 1 threads cannot
+    seen = Concurrency()
+    guards, outcomes = _barrier_callbacks(node, ReentrantCallbackGroup(), barrier, seen)
+    executor = MultiThreadedExecutor(num_threads=N - 1)
+    executor.add_node(node)
+    spinner = Background(executor)
+    try:
+        for guard in guards:
+            guard.trigger()
+        assert wait_until(lambda: len(outcomes) == N, 40.0), outcomes
+    finally:
+        spinner.stop()
+    assert outcomes == ["broken"] * N
+    assert barrier.broken
+    assert seen.most <= N - 1
+    assert len(seen.threads) <= N - 1
+
+
+# --- 5. a custom callback group --------------------------------------------------------------
+
+
+class TokenGroup(CallbackGroup):
+    """Grants a fixed number of runs and never refills (a token bucket without a refill)."""
+
+    def __init__(self, tokens: int) -> None:
+        super().__init__()
+        self.tokens = tokens
+        self.lock = threading.Lock()
+        self.began = 0
+        self.ended = 0
+
+    def can_execute(self, entity: Any) -> bool:
+        with self.lock:
+            return self.tokens > 0
+
+    def beginning_execution(self, entity: Any) -> bool:
+        with self.lock:
+            if self.tokens <= 0:
+                return False
+            self.tokens -= 1
+            self.began += 1
+            return True
+
+    def ending_execution(self, entity: Any) -> None:
+        with self.lock:
+            self.ended += 1
+
+
+@pytest.mark.parametrize("kind", [SingleThreadedExecutor, MultiThreadedExecutor])
+def test_a_custom_callback_group_decides_how_often_its_timer_runs(ros, kind):
+    node = ros.Node("throttled")
+    group = TokenGroup(tokens=5)
+    runs = {"throttled": 0, "free": 0}
+    node.create_timer(0.002, lambda: runs.__setitem__("throttled", runs["throttled"] + 1), group)
+    node.create_timer(0.002, lambda: runs.__setitem__("free", runs["free"] + 1))
+    executor = kind()
+    executor.add_node(node)
+    spinner = Background(executor)
+    try:
+        # the free timer keeps running long after the tokens are spent
+        assert wait_until(lambda: runs["free"] >= 50 and runs["throttled"] >= 5, BOUND), runs
+    finally:
+        spinner.stop()
+    assert runs["throttled"] == 5
+    assert group.began == group.ended == 5
+    assert group.has_entity(node.timers[-2])
+
+
+# --- 6. a custom executor written against rclpy's API ----------------------------------------
+
+
+class PriorityExecutor(Executor):
+    """Runs the callbacks of urgent nodes on one pool, everything else on another."""
+
+    def __init__(self, urgent: list[Any], style: str) -> None:
+        super().__init__()
+        self.urgent = set(urgent)
+        self.style = style
+        self.fast_lane = ThreadPoolExecutor(2, thread_name_prefix="urgent")
+        self.slow_lane = ThreadPoolExecutor(1, thread_name_prefix="ordinary")
+
+    def spin_once(self, timeout_sec: float | None = None) -> None:
+        if self.style == "generator":  # how executors for older rclpy were written
+            try:
+                handler, _group, node = next(self.wait_for_ready_callbacks(timeout_sec=timeout_sec))
+            except StopIteration:
+                return
+        else:
+            try:
+                handler, _group, node = self.wait_for_ready_callbacks(timeout_sec=timeout_sec)
+            except (TimeoutException, ShutdownException):
+                return
+        lane = self.fast_lane if node in self.urgent else self.slow_lane
+        lane.submit(handler)
+
+    def shutdown(self, timeout_sec: float | None = None) -> bool:
+        finished = super().shutdown(timeout_sec)
+        self.fast_lane.shutdown(wait=True)
+        self.slow_lane.shutdown(wait=True)
+        return finished
+
+
+@pytest.mark.parametrize("style", ["tuple", "generator"])
+def test_a_custom_executor_hands_each_nodes_callbacks_to_its_own_pool(ros, style):
+    from std_msgs.msg import Int32
+
+    where: dict[str, set[str]] = {}
+    counts: dict[str, int] = {}
+
+    def record(what: str) -> Callable[..., None]:
+        def callback(*_: Any) -> None:
+            where.setdefault(what, set()).add(threading.current_thread().name)
+            counts[what] = counts.get(what, 0) + 1
+
+        return callback
+
+    urgent, ordinary = ros.Node("urgent"), ros.Node("ordinary")
+    to_urgent = ordinary.create_publisher(Int32, "to_urgent", 10)
+    to_ordinary = urgent.create_publisher(Int32, "to_ordinary", 10)
+    urgent.create_subscription(Int32, "to_urgent", record("urgent message"), 10)
+    ordinary.create_subscription(Int32, "to_ordinary", record("ordinary message"), 10)
+    urgent.create_timer(0.02, lambda: (record("urgent timer")(), to_ordinary.publish(Int32())))
+    ordinary.create_timer(0.02, lambda: (record("ordinary timer")(), to_urgent.publish(Int32())))
+    executor = PriorityExecutor([urgent], style)
+    executor.add_node(urgent)
+    executor.add_node(ordinary)
+    spinner = Background(executor)
+    kinds = ["urgent message", "ordinary message", "urgent timer", "ordinary timer"]
+    try:
+        done = wait_until(lambda: all(counts.get(k, 0) >= 3 for k in kinds), BOUND)
+    finally:
+        spinner.stop()
+    assert done, counts
+    for kind in kinds:
+        prefix = kind.split()[0]
+        assert all(name.startswith(f"{prefix}_") for name in where[kind]), (kind, where)
+
+
+PRIORITY_SCRIPT = """
+import json
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import rclpy
+from rclpy.executors import Executor, ShutdownException, TimeoutException
+from rclpy.node import Node
+
+
+class TwoLanes(Executor):
+    def __init__(self, urgent):
+        super().__init__()
+        self.urgent = urgent
+        self.lanes = {
+            True: ThreadPoolExecutor(1, thread_name_prefix="urgent"),
+            False: ThreadPoolExecutor(1, thread_name_prefix="ordinary"),
+        }
+
+    def spin_once(self, timeout_sec=None):
+        try:
+            handler, group, node = self.wait_for_ready_callbacks(timeout_sec=timeout_sec)
+        except (TimeoutException, ShutdownException):
+            return
+        self.lanes[node is self.urgent].submit(handler)
+
+
+def main():
+    rclpy.init()
+    fast, slow = Node("fast"), Node("slow")
+    where = {"fast": set(), "slow": set()}
+    for node in (fast, slow):
+        node.create_timer(0.02, lambda n=node.get_name(): where[n].add(threading.current_thread().name))
+    executor = TwoLanes(fast)
+    executor.add_node(fast)
+    executor.add_node(slow)
+    deadline = time.monotonic() + 20
+    while not all(where.values()) and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.1)
+    executor.shutdown()
+    for lane in executor.lanes.values():
+        lane.shutdown()
+    print(json.dumps({k: sorted(v) for k, v in where.items()}), flush=True)
+    rclpy.shutdown()
+
+
+main()
+"""
+
+
+def test_an_rclpy_script_subclassing_executor_runs_its_nodes_on_its_pools(spawn, tmp_path):
+    child = _start_script(spawn, tmp_path, PRIORITY_SCRIPT)
+    out, err = child.finish(timeout=40.0)
+    assert child.returncode == 0, err
+    where = json.loads(out.strip().splitlines()[-1])
+    assert where["fast"], where
+    assert where["slow"], where
+    assert all(name.startswith("urgent_") for name in where["fast"]), where
+    assert all(name.startswith("ordinary_") for name in where["slow"]), where
+
+
+# --- 7. coroutine callbacks ------------------------------------------------------------------
+
+SERVER = """
+import sys
+import time
+
+import rosl
+from example_interfaces.srv import AddTwoInts
+from std_msgs.msg import Int32
+
+rosl.init()
+node = rosl.Node("adder")
+side = node.create_publisher(Int32, "meanwhile", 10)
+
+
+def add(request, response):
+    for n in range(int(sys.argv[1])):  # messages sent while the caller waits for the answer
+        side.publish(Int32(data=n))
+    time.sleep(0.2 if int(sys.argv[1]) else 0.0)
+    response.sum = request.a + request.b
+    print("served", request.a, request.b, flush=True)
+    return response
+
+
+node.create_service(AddTwoInts, "add_two_ints", add)
+print("ready", flush=True)
+rosl.spin(node)
+"""
+
+
+def test_an_async_timer_awaits_a_service_of_a_node_in_the_same_executor(ros):
+    from example_interfaces.srv import AddTwoInts
+
+    server = ros.Node("local_adder")
+    server.create_service(AddTwoInts, "local_add", _adder)
+    caller = ros.Node("async_caller")
+    client = caller.create_client(AddTwoInts, "local_add")  # the node's default group
+    results: list[int] = []
+
+    async def once() -> None:
+        timer.cancel()
+        response = await client.call_async(AddTwoInts.Request(a=40, b=2))
+        results.append(response.sum)
+
+    timer = caller.create_timer(0.01, once)  # the same default (mutually exclusive) group
+    assert client.callback_group is timer.callback_group is caller.default_callback_group
+    assert client.wait_for_service(timeout_sec=BOUND)
+    executor = SingleThreadedExecutor()
+    executor.add_node(server)
+    executor.add_node(caller)
+    try:
+        assert spin_until(executor, lambda: bool(results)), "the awaited call never ended"
+    finally:
+        executor.shutdown(timeout_sec=2.0)  # a stuck coroutine would hold it
+    assert results == [42]
+
+
+def test_an_async_subscription_callback_awaits_a_service_in_another_process(ros, spawn):
+    from example_interfaces.srv import AddTwoInts
+    from std_msgs.msg import Int32
+
+    child = spawn(SERVER, "0")
+    child.expect("^ready$")
+    node = ros.Node("async_listener")
+    client = node.create_client(AddTwoInts, "add_two_ints")
+    results: list[tuple[int, int]] = []
+
+    async def on_message(msg: Any) -> None:
+        response = await client.call_async(AddTwoInts.Request(a=msg.data, b=100))
+        results.append((msg.data, response.sum))
+
+    node.create_subscription(Int32, "numbers", on_message, 10)
+    pub = node.create_publisher(Int32, "numbers", 10)
+    assert client.wait_for_service(timeout_sec=BOUND)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        for n in (1, 2, 3):
+            pub.publish(Int32(data=n))
+        assert spin_until(executor, lambda: len(results) == 3), results
+    finally:
+        executor.shutdown(timeout_sec=2.0)  # a stuck coroutine would hold it
+    assert results == [(1, 101), (2, 102), (3, 103)]
+
+
+def test_an_async_service_callback_answers_after_awaiting(ros):
+    from example_interfaces.srv import AddTwoInts
+
+    server = ros.Node("slow_adder")
+    executor = SingleThreadedExecutor()
+    waiting: list[tuple[Future[int], int]] = []
+
+    async def add_later(request: Any, response: Any) -> Any:
+        later = executor.create_future()
+        waiting.append((later, request.a * 10))
+        response.sum = await later + request.b  # completed by the timer, a callback later
+        return response
+
+    def complete() -> None:
+        while waiting:
+            later, value = waiting.pop()
+            later.set_result(value)
+
+    server.create_service(AddTwoInts, "add_later", add_later)
+    server.create_timer(0.01, complete, MutuallyExclusiveCallbackGroup())
+    executor.add_node(server)
+    caller = ros.Node("plain_caller")  # no executor: Client.call waits for its own answer
+    client = caller.create_client(AddTwoInts, "add_later")
+    spinner = Background(executor)
+    try:
+        assert client.wait_for_service(timeout_sec=BOUND)
+        answer = client.call(AddTwoInts.Request(a=4, b=2), timeout_sec=BOUND)
+    finally:
+        spinner.stop()
+    assert answer.sum == 42
+
+
+def test_create_task_runs_a_coroutine_function_to_completion(ros):
+    node = ros.Node("tasker")
+    gate: Future[int] = Future()
+    node.create_timer(0.01, lambda: None if gate.done() else gate.set_result(5))
+
+    async def work(a: int, b: int) -> int:
+        extra = await gate
+        return a + b + extra
+
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        task = executor.create_task(work, 20, 17)
+        executor.spin_until_future_complete(task, timeout_sec=BOUND)
+        plain = executor.create_task(lambda: "plain")
+        executor.spin_until_future_complete(plain, timeout_sec=BOUND)
+    finally:
+        executor.shutdown(timeout_sec=BOUND)
+    assert task.done()
+    assert task.result() == 42
+    assert plain.result() == "plain"
+
+
+def test_tasks_created_together_all_run_when_spinning_until_the_first_completes(ros):
+    node = ros.Node("many_tasks")
+    node.create_timer(0.005, lambda: None)  # spin_once always has something to run
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        first = executor.create_task(lambda: "first")
+        second = executor.create_task(lambda: "second")
+        executor.spin_until_future_complete(first, timeout_sec=BOUND)
+        for _ in range(20):  # a scheduled task is offered before the timer
+            if second.done():
+                break
+            executor.spin_once(timeout_sec=BOUND)
+    finally:
+        executor.shutdown(timeout_sec=BOUND)
+    assert first.result() == "first"
+    assert second.result() == "second"
+
+
+# --- 8. Client.call inside a callback --------------------------------------------------------
+
+
+def test_client_call_inside_a_subscription_callback_answers_and_loses_no_message(ros, spawn):
+    from example_interfaces.srv import AddTwoInts
+    from std_msgs.msg import Int32
+
+    child = spawn(SERVER, "5")
+    child.expect("^ready$")
+    node = ros.Node("calling_listener")
+    client = node.create_client(AddTwoInts, "add_two_ints")
+    events: list[str] = []
+
+    def on_trigger(msg: Any) -> None:
+        events.append("call")
+        answer = client.call(AddTwoInts.Request(a=msg.data, b=1), timeout_sec=BOUND)
+        events.append(f"answer {answer.sum}")
+
+    node.create_subscription(Int32, "trigger", on_trigger, 10)
+    node.create_subscription(Int32, "meanwhile", lambda m: events.append(f"side {m.data}"), 10)
+    pub = node.create_publisher(Int32, "trigger", 10)
+    assert client.wait_for_service(timeout_sec=BOUND)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        pub.publish(Int32(data=41))
+        assert spin_until(executor, lambda: len(events) >= 7), events
+    finally:
+        executor.shutdown(timeout_sec=BOUND)
+    assert events == ["call", "answer 42", *[f"side {n}" for n in range(5)]]
+    child.expect("^served 41 1$")
+
+
+# --- 9. guard conditions and waitables -------------------------------------------------------
+
+
+def test_a_guard_condition_triggered_by_another_thread_wakes_a_blocked_spin_once(ros):
+    node, executor = settled(ros, "guarded")
+    ran: list[str] = []
+    guard = node.create_guard_condition(lambda: ran.append(threading.current_thread().name))
+    spinning = threading.Thread(target=executor.spin_once, name="spinner", daemon=True)
+    spinning.start()
+    spinning.join(0.3)
+    assert spinning.is_alive(), "spin_once(timeout_sec=None) returned with nothing ready"
+    assert ran == []
+
+    threading.Thread(target=guard.trigger, daemon=True).start()
+    spinning.join(30.0)
+    assert not spinning.is_alive(), "a trigger from another thread did not wake spin_once"
+    assert ran == ["spinner"]
+
+
+def test_two_triggers_before_the_executor_looks_run_the_callback_once_or_twice(ros):
+    node = ros.Node("twice")
+    ran: list[int] = []
+    guard = node.create_guard_condition(lambda: ran.append(1))
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    guard.trigger()
+    guard.trigger()
+    assert spin_until(executor, lambda: bool(ran))
+    for _ in range(5):
+        executor.spin_once(timeout_sec=0.05)
+    assert 1 <= len(ran) <= 2
+
+
+class Mailbox(Waitable):
+    """A waitable that is ready while letters wait; ``post`` may be called from any thread."""
+
+    def __init__(self, group: CallbackGroup | None) -> None:
+        super().__init__(group)
+        self.letters: list[str] = []
+        self.lock = threading.Lock()
+        self.read: list[tuple[str, str]] = []
+
+    def post(self, letter: str) -> None:
+        with self.lock:
+            self.letters.append(letter)
+        self.wake()
+
+    def is_ready(self, wait_set: Any) -> bool:
+        with self.lock:
+            return bool(self.letters)
+
+    def take_data(self) -> Any:
+        with self.lock:
+            return self.letters.pop(0)
+
+    async def execute(self, taken_data: Any) -> None:
+        self.read.append((taken_data, threading.current_thread().name))
+
+
+def test_a_waitable_made_ready_by_another_thread_runs(ros):
+    node, executor = settled(ros, "post_office")
+    box = Mailbox(None)
+    node.add_waitable(box)
+    spinning = threading.Thread(target=executor.spin_once, name="spinner", daemon=True)
+    spinning.start()
+    spinning.join(0.3)
+    assert spinning.is_alive(), "spin_once(timeout_sec=None) returned with nothing ready"
+    threading.Thread(target=box.post, args=("first",), daemon=True).start()
+    spinning.join(30.0)
+    assert not spinning.is_alive(), "the waitable did not wake spin_once"
+    assert box.read == [("first", "spinner")]
+
+    for letter in ("second", "third"):
+        box.post(letter)
+    assert spin_until(executor, lambda: len(box.read) == 3), box.read
+    assert [letter for letter, _ in box.read] == ["first", "second", "third"]
+
+
+# --- 10. rclpy's submodules after `import rclpy` ---------------------------------------------
+
+SUBMODULES_SCRIPT = """
+import json
+
+import rclpy
+
+rclpy.init()
+node = rclpy.create_node("submodules")
+group = rclpy.callback_groups.ReentrantCallbackGroup()
+finished = rclpy.task.Future()
+node.create_timer(0.01, lambda: finished.done() or finished.set_result("ticked"), group)
+executor = rclpy.executors.MultiThreadedExecutor(num_threads=2)
+executor.add_node(node)
+executor.spin_until_future_complete(finished, timeout_sec=20)
+import rosl.executor, rosl.node.callback_groups, rosl.node.task
+print(json.dumps({
+    "result": finished.result(),
+    "executor": rclpy.executors.MultiThreadedExecutor is rosl.executor.MultiThreadedExecutor,
+    "group": rclpy.callback_groups.ReentrantCallbackGroup
+    is rosl.node.callback_groups.ReentrantCallbackGroup,
+    "future": rclpy.task.Future is rosl.node.task.Future,
+}), flush=True)
+executor.shutdown()
+rclpy.shutdown()
+"""
+
+
+def test_rclpy_executors_callback_groups_and_task_are_reachable_after_import_rclpy(spawn, tmp_path):
+    child = _start_script(spawn, tmp_path, SUBMODULES_SCRIPT)
+    out, err = child.finish(timeout=40.0)
+    assert child.returncode == 0, err
+    assert json.loads(out.strip().splitlines()[-1]) == {
+        "result": "ticked",
+        "executor": True,
+        "group": True,
+        "future": True,
+    }
+
+
+# --- 11. keep-last queues --------------------------------------------------------------------
+
+
+def test_a_subscription_not_spun_keeps_only_its_depth_of_the_latest_messages(ros):
+    from std_msgs.msg import Int32
+
+    reader = ros.Node("slow_reader")
+    got: dict[int, list[int]] = {3: [], 10: []}
+    subs = {
+        depth: reader.create_subscription(
+            Int32, "burst", lambda m, d=depth: got[d].append(m.data), depth
+        )
+        for depth in (3, 10)
+    }
+    talker = ros.Node("burst_talker")
+    pub = talker.create_publisher(Int32, "burst", 10)
+    for n in range(10):
+        pub.publish(Int32(data=n))
+
+    def all_arrived() -> bool:
+        reader.participant.poll(0.05)  # reads the socket into the queues; runs no callback
+        return all(len(s._queue) + s.dropped == 10 for s in subs.values())
+
+    assert wait_until(all_arrived, BOUND, 0.0), {d: len(s._queue) for d, s in subs.items()}
+    assert got == {3: [], 10: []}
+    executor = SingleThreadedExecutor()
+    executor.add_node(reader)
+    try:
+        assert spin_until(executor, lambda: len(got[3]) == 3 and len(got[10]) == 10), got
+    finally:
+        executor.shutdown(timeout_sec=BOUND)
+    assert got[3] == [7, 8, 9]
+    assert subs[3].dropped == 7
+    assert got[10] == list(range(10))
+    assert subs[10].dropped == 0
+
+
+# --- 12. shutdown and remove_node ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", [SingleThreadedExecutor, MultiThreadedExecutor])
+def test_shutdown_makes_spin_in_another_thread_return(ros, kind):
+    node = ros.Node("stoppable")
+    ticks: list[int] = []
+    node.create_timer(0.01, lambda: ticks.append(1))
+    executor = kind()
+    executor.add_node(node)
+    spinning = threading.Thread(target=executor.spin, daemon=True)
+    spinning.start()
+    assert wait_until(lambda: len(ticks) >= 3, BOUND)
+    assert executor.shutdown(timeout_sec=BOUND)
+    spinning.join(BOUND)
+    assert not spinning.is_alive(), "spin() kept running after shutdown()"
+    assert executor.get_nodes() == []
+    assert node.executor is None
+
+
+def test_a_removed_node_has_no_more_callbacks_run(ros):
+    from std_msgs.msg import Int32
+
+    gone, staying = ros.Node("gone"), ros.Node("staying")
+    counts = {"gone": 0, "gone msg": 0, "staying": 0}
+
+    def count(key: str) -> Callable[..., None]:
+        return lambda *_: counts.__setitem__(key, counts[key] + 1)
+
+    gone.create_timer(0.005, count("gone"))
+    gone.create_subscription(Int32, "still_sent", count("gone msg"), 10)
+    staying.create_timer(0.005, count("staying"))
+    pub = staying.create_publisher(Int32, "still_sent", 10)
+    staying.create_timer(0.005, lambda: pub.publish(Int32()))
+    executor = SingleThreadedExecutor()
+    executor.add_node(gone)
+    executor.add_node(staying)
+    assert spin_until(executor, lambda: counts["gone"] >= 3 and counts["gone msg"] >= 3)
+
+    executor.remove_node(gone)
+    assert gone.executor is None
+    assert executor.get_nodes() == [staying]
+    # what was already handed out before the removal may still run once per entity
+    after_removal = dict(counts)
+    mark = counts["staying"]
+    assert spin_until(executor, lambda: counts["staying"] >= mark + 5)
+    assert counts["gone"] - after_removal["gone"] <= 1
+    assert counts["gone msg"] - after_removal["gone msg"] <= 1
+    settled = dict(counts)
+    mark = counts["staying"]
+    assert spin_until(executor, lambda: counts["staying"] >= mark + 20)
+    executor.shutdown(timeout_sec=BOUND)
+    assert counts["gone"] == settled["gone"]
+    assert counts["gone msg"] == settled["gone msg"]
+    assert len(gone.subscriptions[0]._queue) > 0  # its messages still arrive, unhandled
