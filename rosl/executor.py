@@ -92,6 +92,7 @@ class Executor:
         self.answers_lockstep = True  # rosl: answer lock-stepped simulators when idle
         self._work = 0  # callbacks running (shutdown waits for them)
         self._work_lock = threading.Lock()
+        self._inside = threading.local()  # depth: callbacks of this executor on this thread
 
     @property
     def context(self) -> Context:
@@ -149,11 +150,12 @@ class Executor:
         """Stop spinning and wait for running callbacks; False if they outlast the timeout."""
         self._is_shutdown = True
         self.wake()
+        own = getattr(self._inside, "depth", 0)  # called from a callback: do not wait for it
         forever = timeout_sec is None or timeout_sec < 0
         deadline = time.monotonic() + (0.0 if forever else (timeout_sec or 0.0))
-        while self._work and (forever or time.monotonic() < deadline):
+        while self._work > own and (forever or time.monotonic() < deadline):
             time.sleep(0.005)
-        finished = self._work == 0
+        finished = self._work <= own
         with self._nodes_lock:
             nodes, self._nodes = self._nodes, ()
             for node in nodes:
@@ -223,11 +225,11 @@ class Executor:
         future.add_done_callback(lambda _: self.wake())
         forever = timeout_sec is None or timeout_sec < 0
         deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
-        while self._running() and not future.done():
-            remaining = None if deadline is None else deadline - time.monotonic()
-            if remaining is not None and remaining <= 0:
-                return
+        while self._running() and not future.done() and not future.cancelled():
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             self._spin_once_until(future, remaining)
+            if deadline is not None and time.monotonic() >= deadline:
+                return
 
     def spin_once_until_future_complete(
         self, future: Future[Any], timeout_sec: float | None = None
@@ -316,12 +318,12 @@ class Executor:
                 raise ConditionReachedException
             while batch:
                 item, node = batch.popleft()
-                if only is not None and node is not None and node not in only:
+                if node is not None and node not in (self._nodes if only is None else only):
                     if isinstance(item, Task):
                         self._schedule(item)  # for another call
                     continue
                 if isinstance(item, Task):
-                    if not item.done():
+                    if not (item.done() or item.cancelled()):
                         return item, node
                 elif self.can_execute(item) and item._ready():
                     item._executor_event = True  # not offered again until taken
@@ -336,8 +338,8 @@ class Executor:
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None and remaining <= 0 and waited:
                 raise TimeoutException
-            if participant is not None and self.answers_lockstep:
-                self._answer_lockstep(participant, chosen)
+            if participant is not None and self.answers_lockstep and not self._work:
+                self._answer_lockstep(participant, chosen)  # (after every running callback)
             wait = self._next_timer(chosen)
             if remaining is not None:
                 wait = max(0.0, remaining) if wait is None else min(wait, max(0.0, remaining))
@@ -422,17 +424,19 @@ class Executor:
             return None
         with self._work_lock:
             self._work += 1
+        inside = self._inside
+        inside.depth = getattr(inside, "depth", 0) + 1
         try:
-            work = entity._take()
-        finally:
-            entity._executor_event = False
-            self.wake()  # it may be offered again (a reentrant group)
-        if work is None:
-            self._end(entity, group)
-            return None
-        if entity._is_timer:
-            self._timers_ran += 1
-        try:
+            try:
+                work = entity._take()
+            finally:
+                entity._executor_event = False
+                self.wake()  # it may be offered again (a reentrant group)
+            if work is None:
+                self._end(entity, group)
+                return None
+            if entity._is_timer:
+                self._timers_ran += 1
             result = work()
         except Exception as err:
             self._end(entity, group)
@@ -441,6 +445,8 @@ class Executor:
         except BaseException:
             self._end(entity, group)
             raise
+        finally:
+            inside.depth -= 1
         if inspect.iscoroutine(result):
             return self._finish(result, entity, node, group)
         self._end(entity, group)
@@ -513,6 +519,8 @@ class MultiThreadedExecutor(Executor):
 
     def __init__(self, num_threads: int | None = None, *, context: Context | None = None) -> None:
         super().__init__(context=context)
+        if num_threads is not None and num_threads < 1:
+            raise ValueError(f"MultiThreadedExecutor needs num_threads >= 1, got {num_threads}")
         self.num_threads = num_threads or _default_threads()
         self._rotate = True
         self._pool = ThreadPoolExecutor(self.num_threads, thread_name_prefix="rosl-executor")
@@ -526,10 +534,14 @@ class MultiThreadedExecutor(Executor):
             assert node is not None
             handler = Task(self._execute, (item, node), executor=self)
             handler.entity, handler.node = item, node
-        handler.add_done_callback(lambda _: self.wake())
+        with self._handlers_lock:
+            new = handler not in self._handlers  # a suspended task comes back: once is enough
+            if new:
+                self._handlers.append(handler)
+        if new:
+            handler.add_done_callback(lambda _: self.wake())
         self._pool.submit(handler)
         with self._handlers_lock:
-            self._handlers.append(handler)
             failed = [h for h in self._handlers if h.done() and h.exception() is not None]
             self._handlers = [h for h in self._handlers if not h.done()]
         if failed:

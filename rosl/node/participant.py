@@ -56,7 +56,9 @@ class Participant:
         self._describers: dict[int, Callable[[], NodeRecord]] = {}
         self._handlers: dict[int, list[Handler]] = {}
         self._lock = threading.RLock()
-        self._cond = threading.Condition(threading.Lock())  # executors waiting for work
+        # executors waiting for work; reentrant: a signal handler may notify() while the
+        # thread it interrupted holds it
+        self._cond = threading.Condition(threading.RLock())
         self._waiting = 0  # threads asleep on _cond
         self._poll_lock = threading.Lock()  # one thread polls the receiver at a time
         self._poller: int | None = None  # that thread
@@ -197,12 +199,13 @@ class Participant:
         """
         deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
         first = True
-
-        def done() -> bool:
-            return self.changes != since if since is not None else ready()
-
         while True:
-            if done():
+            # user code (ready) runs with no lock held; under locks only `changes` is compared
+            snapshot = self.changes
+            if since is not None:
+                if snapshot != since:
+                    return True
+            elif ready():
                 return True
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None:
@@ -213,22 +216,21 @@ class Participant:
             if not self.closed and self._poll_lock.acquire(blocking=False):
                 try:
                     self._poller = threading.get_ident()
-                    if done():  # checked after claiming the poll: a notify from now on wakes us
-                        return True
-                    self._poll_locked(remaining, None)
+                    if self.changes == snapshot:  # else something changed: look again first
+                        self._poll_locked(remaining, None)
                 finally:
                     self._poller = None
                     self._poll_lock.release()
-                if self._waiting:  # another thread may take over polling, or was served
-                    with self._cond:
-                        self._cond.notify_all()
+                    if self._waiting:  # another thread may take over polling, or was served
+                        with self._cond:
+                            self._cond.notify_all()
                 continue
             with self._cond:
                 self._waiting += 1
                 try:
-                    if done():
-                        return True
-                    self._cond.wait(remaining if remaining is not None or not self.closed else 0.1)
+                    # sleep only while someone polls and nothing changed since the look above
+                    if self.changes == snapshot and (self._poll_lock.locked() or self.closed):
+                        self._cond.wait(0.1 if remaining is None and self.closed else remaining)
                 finally:
                     self._waiting -= 1
 

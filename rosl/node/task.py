@@ -53,12 +53,15 @@ class Future(Generic[T]):
         return self._cancelled
 
     def cancel(self) -> None:
-        """Cancel the future (no effect once done)."""
+        """Cancel the future (no effect once done).
+
+        Done callbacks run; ``done()`` stays False, as in rclpy.
+        """
         with self._lock:
-            if self._done:
+            if self._done or self._cancelled:
                 return
             self._cancelled = True
-        self._finish()
+        self._finish(done=False)
 
     def result(self) -> T | None:
         """The result (None if not done); raises the exception if one was set."""
@@ -87,7 +90,7 @@ class Future(Generic[T]):
     def add_done_callback(self, callback: Callable[[Future[T]], None]) -> None:
         """Call ``callback(future)`` when done (at once if already done)."""
         with self._lock:
-            if not self._done:
+            if not (self._done or self._cancelled):
                 self._callbacks.append(callback)
                 return
         callback(self)
@@ -103,16 +106,16 @@ class Future(Generic[T]):
     def wait(self, timeout: float | None = None) -> bool:
         """Block until done (for threads that do not spin); return whether it is done."""
         with self._lock:
-            if self._done:
+            if self._done or self._cancelled:
                 return True
             if self._event is None:
                 self._event = threading.Event()
             event = self._event
         return event.wait(timeout)
 
-    def _finish(self) -> None:
+    def _finish(self, done: bool = True) -> None:
         with self._lock:
-            self._done = True
+            self._done = done
             callbacks, self._callbacks = self._callbacks, []
             event = self._event
         if event is not None:
@@ -155,11 +158,11 @@ class Task(Future[T]):
 
     def __call__(self) -> None:
         """Run the task, or resume it, until it completes or waits for a future."""
-        if self._done:
+        if self._done or self._cancelled:
             return
         # a step on another thread ends soon (at its next await); then this one runs
         with self._task_lock:
-            if self._done:
+            if self._done or self._cancelled:
                 return
             self._executing = True
             try:

@@ -1009,3 +1009,81 @@ def test_a_removed_node_has_no_more_callbacks_run(ros):
     assert counts["gone"] == settled["gone"]
     assert counts["gone msg"] == settled["gone msg"]
     assert len(gone.subscriptions[0]._queue) > 0  # its messages still arrive, unhandled
+
+
+# --- review findings ----------------------------------------------------------------------
+
+
+def test_threads_calling_a_service_while_a_multithreaded_executor_spins_all_get_answers(ros):
+    # rclpy's usual pattern: spin in the background, call from other threads
+    from example_interfaces.srv import AddTwoInts
+
+    server = ros.Node("threads_server")
+    server.create_service(AddTwoInts, "threads_add", _adder)
+    asker = ros.Node("threads_asker")
+    client = asker.create_client(AddTwoInts, "threads_add")
+    executor = MultiThreadedExecutor(num_threads=4)
+    executor.add_node(server)
+    executor.add_node(asker)
+    spinner = Background(executor)
+    answers: list[int] = []
+    failures: list[BaseException] = []
+
+    def calls(offset: int) -> None:
+        try:
+            for n in range(50):
+                answers.append(client.call(AddTwoInts.Request(a=offset, b=n), BOUND).sum)
+        except BaseException as err:
+            failures.append(err)
+
+    try:
+        assert client.wait_for_service(BOUND)
+        threads = [threading.Thread(target=calls, args=(k * 1000,)) for k in range(3)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join(4 * BOUND)
+        assert not any(t.is_alive() for t in threads), "a client.call never returned"
+    finally:
+        spinner.stop()
+    assert failures == []
+    assert sorted(answers) == sorted(k * 1000 + n for k in range(3) for n in range(50))
+
+
+def test_shutdown_called_from_a_callback_ends_spin(ros):
+    node, executor = settled(ros, "self_stopping")
+    results: list[bool] = []
+    node.create_timer(0.01, lambda: results.append(executor.shutdown()))
+    spinner = threading.Thread(target=executor.spin, daemon=True)
+    spinner.start()
+    spinner.join(BOUND)
+    assert not spinner.is_alive(), "spin() did not return after shutdown() from a callback"
+    assert results == [True]
+
+
+def test_spin_until_future_complete_with_timeout_zero_still_spins_once(ros):
+    node, executor = settled(ros, "zero_timeout")
+    future: Future[int] = Future()
+    node.create_timer(0.001, lambda: future.set_result(42))
+    assert wait_until(lambda: node.timers[-1].is_ready(), BOUND)
+    executor.spin_until_future_complete(future, timeout_sec=0)
+    assert future.done()
+    assert future.result() == 42
+
+
+def test_a_node_removed_between_spins_runs_nothing_already_found(ros):
+    a = ros.Node("removed_a")
+    b = ros.Node("kept_b")
+    ran: list[str] = []
+    a.create_timer(0.001, lambda: ran.append("a1"))
+    a.create_timer(0.001, lambda: ran.append("a2"))
+    executor = SingleThreadedExecutor()
+    executor.add_node(a)
+    executor.add_node(b)
+    assert wait_until(lambda: all(t.is_ready() for t in a.timers[-2:]), BOUND)
+    executor.spin_once(timeout_sec=BOUND)  # one look finds both timers; one of them runs
+    assert len(ran) == 1
+    executor.remove_node(a)
+    b.create_timer(0.001, lambda: ran.append("b"))
+    executor.spin_once(timeout_sec=BOUND)
+    assert ran[1:] == ["b"], ran
