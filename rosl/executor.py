@@ -1,13 +1,15 @@
 """Executors: run the callbacks of the nodes added to them, as rclpy's do.
 
 Deliveries wait in their entity's queue (a subscription's, a service's, a client's; see
-:meth:`rosl.node.participant.Participant.dispatch`). ``wait_for_ready_callbacks`` looks at
-the entities of this executor's nodes only — queued deliveries, due timers, triggered guard
-conditions, ready waitables, tasks to resume — and yields a handler for each one its callback
-group lets run; when nothing is ready it waits on the participant (which polls the transport)
-until something is, or the next timer is due. ``SingleThreadedExecutor`` runs each handler on
-the spinning thread, ``MultiThreadedExecutor`` in a pool of threads, and a custom executor
-decides (rclpy's API: subclass :class:`Executor` and call ``wait_for_ready_callbacks``).
+:meth:`rosl.node.participant.Participant.dispatch`). One look at the entities of this
+executor's nodes only — queued deliveries, due timers, triggered guard conditions, ready
+waitables, tasks to resume — finds everything whose callback group lets it run, and hands
+those out one at a time before looking again; when nothing is ready the executor waits on the
+participant (which polls the transport) until something is, or the next timer is due.
+``SingleThreadedExecutor`` runs each callback on the spinning thread, ``MultiThreadedExecutor``
+in a pool of threads, and a custom executor decides (rclpy's API: subclass :class:`Executor`,
+call ``wait_for_ready_callbacks`` and run or hand off the handler task it returns). rosl's own
+housekeeping (a node's name check) never counts as ``spin_once``'s one callback.
 
 Two choices differ from rclpy, both to remove its classic deadlocks: a client's response
 completes its future whatever the client's callback group is doing (so a callback in a
