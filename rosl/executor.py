@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import inspect
 import os
+import signal
 import threading
 import time
 from collections import deque
@@ -86,6 +87,7 @@ class Executor:
         self._ready_tasks: deque[Task[Any]] = deque()
         self._tasks_lock = threading.Lock()
         self._is_shutdown = False
+        self._told_external = False  # spin_once returned once after the context shut down
         self._batch: deque[tuple[Any, Node | None]] = deque()  # found ready, not handed out
         self._turn = 0  # rotates the order of what one look finds (see _collect)
         self._rotate = False  # only with threads: one thread runs a whole look in order
@@ -183,9 +185,16 @@ class Executor:
         return not self._is_shutdown and self._context.ok()
 
     def spin(self) -> None:
-        """Run callbacks until the context shuts down (Ctrl-C) or :meth:`shutdown`."""
+        """Run callbacks until the context shuts down (Ctrl-C) or :meth:`shutdown`.
+
+        Returns quietly then (rosl's Ctrl-C: the cleanup after ``spin`` runs), also for
+        custom executors whose ``spin_once`` lets the shutdown exceptions out.
+        """
         while self._running():
-            self.spin_once()
+            try:
+                self.spin_once()
+            except (ShutdownException, ExternalShutdownException):
+                return
 
     def spin_once(self, timeout_sec: float | None = None) -> None:
         """Wait for one callback and run it.
@@ -198,11 +207,29 @@ class Executor:
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             try:
                 item, node = self._next_work(remaining)
+            except ExternalShutdownException:
+                self._after_external_shutdown()
+                return
             except _STOPS:
                 return
             self._run(item, node)
             if not item._internal:
                 return  # rosl's own housekeeping does not count as the one callback
+
+    def _after_external_shutdown(self) -> None:
+        """``spin_once`` after the context was shut down: return once, then end the loop.
+
+        The first call returns quietly, so ``while rclpy.ok(): spin_once()`` ends as usual.
+        A loop that calls again (``while True``) would spin hot for ever; as with rclpy, where
+        Ctrl-C raises out of ``spin_once``, it gets KeyboardInterrupt after Ctrl-C (else
+        ExternalShutdownException).
+        """
+        if not self._told_external:
+            self._told_external = True
+            return
+        if self._context.signalled == signal.SIGINT:
+            raise KeyboardInterrupt
+        raise ExternalShutdownException
 
     def spin_some(self, timeout_sec: float = 0.0) -> int:
         """Run every callback ready now, waiting up to ``timeout_sec`` for the first; how many.

@@ -311,7 +311,7 @@ class SimNode:
         """Real-time factor pacing: serve the bus until the next step is due in wall time."""
         factor = self.options.real_time_factor
         due = started + (self.sim.now_ns + self.sim.step_ns) / NS / factor
-        while True:
+        while self.node.context.ok():
             remaining = due - time.monotonic()
             if remaining <= 0:
                 return

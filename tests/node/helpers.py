@@ -27,6 +27,7 @@ class Child(ChildOutput):
         self._processes = processes
         self._pos = {s: 0 for s in STREAMS}
         self.stopped = False
+        self.stopped_by_us = False  # finish() had to stop it
 
     # --- reading ---------------------------------------------------------------------------
 
@@ -73,6 +74,7 @@ class Child(ChildOutput):
             self._read(min(remaining, 0.05))
         with contextlib.suppress(subprocess.TimeoutExpired):
             self.popen.wait(timeout=max(0.1, deadline - time.monotonic()))
+        self.stopped_by_us = self.popen.poll() is None  # it had to be Ctrl-C'd (or killed)
         return self.stop()
 
     def stop(self, timeout: float = 5.0) -> tuple[str, str]:

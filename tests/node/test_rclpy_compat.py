@@ -247,3 +247,30 @@ def test_rosl_spin_and_friends_stay_functions_after_nodes_are_created(ros):
         assert callable(getattr(ros, name)), f"rosl.{name} is {getattr(ros, name)!r}"
     assert rclpy_spin is ros.spin
     assert node.get_name() == "api_check"
+
+
+LOOP_SCRIPT = """
+import rclpy
+from rclpy.node import Node
+
+rclpy.init()
+node = Node("looper")
+print("looping", flush=True)
+try:
+    while True:  # no rclpy.ok(): only Ctrl-C ends it, as in rclpy
+        rclpy.spin_once(node, timeout_sec=0.1)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+node.destroy_node()
+rclpy.try_shutdown()
+"""
+
+
+def test_a_script_looping_over_spin_once_without_ok_ends_on_the_first_ctrl_c(spawn, tmp_path):
+    child = _start(spawn, tmp_path, LOOP_SCRIPT)
+    child.expect("^looping$")
+    child.popen.send_signal(signal.SIGINT)
+    out, err = child.finish()
+    assert not child.stopped_by_us, "one Ctrl-C did not end the loop (it needed a second)"
+    assert "interrupted" in out, err
+    assert child.returncode == 0, err
