@@ -20,6 +20,7 @@ the future completes, not by polling.
 
 from __future__ import annotations
 
+import functools
 import inspect
 import os
 import signal
@@ -91,7 +92,6 @@ class Executor:
         self._batch: deque[tuple[Any, Node | None]] = deque()  # found ready, not handed out
         self._turn = 0  # rotates the order of what one look finds (see _collect)
         self._rotate = False  # only with threads: one thread runs a whole look in order
-        self._waiting_on: tuple[tuple[Node, ...], Callable[[], bool] | None] = ((), None)
         self._timers_ran = 0  # timer callbacks since the last lock-step answer
         self.answers_lockstep = True  # rosl: answer lock-stepped simulators when idle
         self._work = 0  # callbacks running (shutdown waits for them)
@@ -146,9 +146,7 @@ class Executor:
 
     def wake(self) -> None:
         """Make a waiting ``wait_for_ready_callbacks`` look again (something changed)."""
-        participant = self._context.participant
-        if participant is not None:
-            participant.notify()
+        self._context.wake_executors()
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         """Stop spinning and wait for running callbacks; False if they outlast the timeout."""
@@ -238,14 +236,10 @@ class Executor:
         """
         ran = 0
         wait: float | None = timeout_sec
-        while True:
-            try:
-                item, node = self._next_work(wait)
-            except _STOPS:
-                return ran
-            self._run(item, node)
+        while self._spin_one(wait):
             ran += 1
             wait = 0.0
+        return ran
 
     def spin_until_future_complete(
         self, future: Future[Any], timeout_sec: float | None = None
@@ -256,7 +250,7 @@ class Executor:
         deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
         while self._running() and not future.done() and not future.cancelled():
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
-            self._spin_once_until(future, remaining)
+            self._spin_one(remaining, future.done)
             if deadline is not None and time.monotonic() >= deadline:
                 return
 
@@ -265,14 +259,18 @@ class Executor:
     ) -> None:
         """One :meth:`spin_once`, returning early when ``future`` completes."""
         future.add_done_callback(lambda _: self.wake())
-        self._spin_once_until(future, timeout_sec)
+        self._spin_one(timeout_sec, future.done)
 
-    def _spin_once_until(self, future: Future[Any], timeout_sec: float | None) -> None:
+    def _spin_one(
+        self, timeout_sec: float | None, condition: Callable[[], bool] | None = None
+    ) -> bool:
+        """Wait for one callback (or ``condition()``) and run it; whether one ran."""
         try:
-            item, node = self._next_work(timeout_sec, None, future.done)
+            item, node = self._next_work(timeout_sec, None, condition)
         except _STOPS:
-            return
+            return False
         self._run(item, node)
+        return True
 
     def _run(self, item: Any, node: Node | None) -> None:
         """Run a task step or an entity's callback on this thread (subclasses may not)."""
@@ -376,12 +374,10 @@ class Executor:
             if participant is None:
                 time.sleep(0.05 if wait is None else min(wait, 0.05))
                 continue
-            self._waiting_on = (chosen, condition)
-            participant.wait(self._wait_ready, wait, changes)
+            participant.wait(functools.partial(self._wait_ready, chosen, condition), wait, changes)
 
-    def _wait_ready(self) -> bool:
+    def _wait_ready(self, nodes: tuple[Node, ...], condition: Callable[[], bool] | None) -> bool:
         """Whether the wait in :meth:`_next_work` may end (asked at its deadline)."""
-        nodes, condition = self._waiting_on
         return (
             not self._running()
             or bool(self._ready_tasks)
@@ -412,12 +408,10 @@ class Executor:
                     with self._tasks_lock:
                         self._ready_tasks.append(task)
         ready: list[tuple[Any, Node | None]] = []
+        can_execute = self.can_execute
         for node in nodes:
             for entity in node._entities():
-                if entity._executor_event or not entity._ready():
-                    continue
-                group = entity.callback_group
-                if group is None or entity._ungrouped or group.can_execute(entity):
+                if entity._ready() and can_execute(entity):
                     if into is None:
                         return True
                     ready.append((entity, node))

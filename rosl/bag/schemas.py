@@ -104,7 +104,7 @@ class Schemas:
                     fresh = True
             if fresh:
                 self.arrived = True
-                self._participant.wake()
+                self._participant.notify()
 
     # --- reading and asking ------------------------------------------------------------------
 
@@ -149,4 +149,4 @@ class Schemas:
                 (str(message["encoding"]), str(message["text"]), str(message.get("hash", ""))),
             )
         self.arrived = True
-        self._participant.wake()
+        self._participant.notify()

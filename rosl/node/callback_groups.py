@@ -103,6 +103,12 @@ class Executable:
     _internal = False  # rosl's housekeeping (spin_once goes on to a callback of the user's)
     _what = "callback"  # how an exception in its callback is introduced
 
+    def _join(self, group: CallbackGroup | None) -> None:
+        """Belong to ``group`` (None: to none)."""
+        self.callback_group = group
+        if group is not None:
+            group.add_entity(self)
+
     def _ready(self) -> bool:
         raise NotImplementedError
 

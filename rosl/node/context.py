@@ -78,9 +78,13 @@ class Context:
     def request_shutdown(self) -> None:
         """Make ``ok()`` false and wake spinning threads (safe in a signal handler)."""
         self._shutdown_requested = True
+        self.wake_executors()
+
+    def wake_executors(self) -> None:
+        """Make executors waiting for work look again (something they wait for changed)."""
         participant = self.participant
         if participant is not None:
-            participant.wake()
+            participant.notify()
 
     def shutdown(self) -> None:
         """Destroy every node, say goodbye on the bus, and close sockets."""

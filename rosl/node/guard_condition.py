@@ -30,9 +30,7 @@ class GuardCondition(Executable):
         from rosl.node.context import default_context
 
         self.callback = callback
-        self.callback_group = callback_group
-        if callback_group is not None:
-            callback_group.add_entity(self)
+        self._join(callback_group)
         self._context = context or default_context
         self._triggered = False
         self.destroyed = False
@@ -40,9 +38,7 @@ class GuardCondition(Executable):
     def trigger(self) -> None:
         """Ask the executor to run the callback (from any thread)."""
         self._triggered = True
-        participant = self._context.participant
-        if participant is not None:
-            participant.notify()
+        self._context.wake_executors()
 
     def _ready(self) -> bool:
         return self._triggered and not self.destroyed

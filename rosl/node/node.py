@@ -320,8 +320,7 @@ class Node:
 
     def _join(self, entity: Executable, group: CallbackGroup | None) -> None:
         chosen = group if group is not None else self.default_callback_group
-        entity.callback_group = chosen
-        chosen.add_entity(entity)
+        entity._join(chosen)
         if chosen not in self.callback_groups:
             self.callback_groups.append(chosen)
 

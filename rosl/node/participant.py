@@ -145,7 +145,7 @@ class Participant:
             self._handlers.setdefault(topic, []).append(handler)
             self.reader.wanted.add(topic)
         self._receiver.join(channel_of(topic))
-        self.wake()
+        self.notify()
 
     def unlisten(self, topic: int, handler: Handler) -> None:
         """Stop delivering a topic/service hash to ``handler``."""
@@ -167,7 +167,7 @@ class Participant:
             self.reader.ignored.add(topic_hash(LOCKSTEP_TOPIC))  # lock-step answers: control only
         for channel in range(1, CHANNELS + 1):
             self._receiver.join(channel)
-        self.wake()
+        self.notify()
 
     # --- receiving ---------------------------------------------------------------------------
 
@@ -183,8 +183,6 @@ class Participant:
         if self._waiting:
             with self._cond:
                 self._cond.notify_all()
-
-    wake = notify
 
     def wait(
         self, ready: Callable[[], bool], timeout: float | None, since: int | None = None

@@ -134,6 +134,8 @@ class Task(Future[T]):
     future that is not done yet.
     """
 
+    _internal = False  # (never rosl's housekeeping: see Executor.spin_once)
+
     def __init__(
         self,
         handler: Callable[..., Any],
@@ -148,7 +150,6 @@ class Task(Future[T]):
         self._coroutine: Coroutine[Any, Any, Any] | None = None
         self._executing = False
         self._task_lock = threading.Lock()
-        self._internal = False  # (a task is never rosl's housekeeping)
         self.entity: Any = None  # what an executor's handler task serves, and its node
         self.node: Any = None
 

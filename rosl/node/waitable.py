@@ -47,9 +47,7 @@ class Waitable(Executable):
     ) -> None:
         from rosl.node.context import default_context
 
-        self.callback_group = callback_group
-        if callback_group is not None:
-            callback_group.add_entity(self)
+        self._join(callback_group)
         self._context = context or default_context
         self._what = type(self).__name__
 
@@ -73,9 +71,7 @@ class Waitable(Executable):
 
     def wake(self) -> None:
         """Tell the executor that :meth:`is_ready` may have changed."""
-        participant = self._context.participant
-        if participant is not None:
-            participant.notify()
+        self._context.wake_executors()
 
     def __enter__(self) -> None:
         return None

@@ -386,12 +386,13 @@ def _barrier_callbacks(
     return guards, outcomes
 
 
-def test_a_reentrant_group_runs_n_callbacks_at_once_on_n_threads(ros):
-    node = ros.Node("reentrant")
-    barrier = threading.Barrier(N, timeout=30.0)  # passes only when N callbacks wait at once
+def _race_to_barrier(
+    node: Any, barrier: threading.Barrier, threads: int
+) -> tuple[list[str], Concurrency]:
+    """N reentrant callbacks wait on ``barrier`` under ``threads`` pool threads; outcomes."""
     seen = Concurrency()
     guards, outcomes = _barrier_callbacks(node, ReentrantCallbackGroup(), barrier, seen)
-    executor = MultiThreadedExecutor(num_threads=N)
+    executor = MultiThreadedExecutor(num_threads=threads)
     executor.add_node(node)
     spinner = Background(executor)
     try:
@@ -400,25 +401,20 @@ def test_a_reentrant_group_runs_n_callbacks_at_once_on_n_threads(ros):
         assert wait_until(lambda: len(outcomes) == N, 40.0), outcomes
     finally:
         spinner.stop()
+    return outcomes, seen
+
+
+def test_a_reentrant_group_runs_n_callbacks_at_once_on_n_threads(ros):
+    barrier = threading.Barrier(N, timeout=30.0)  # passes only when N callbacks wait at once
+    outcomes, seen = _race_to_barrier(ros.Node("reentrant"), barrier, N)
     assert outcomes == ["passed"] * N
     assert seen.most == N
     assert len(seen.threads) == N
 
 
 def test_a_pool_of_fewer_threads_never_runs_more_callbacks_at_once(ros):
-    node = ros.Node("short_handed")
     barrier = threading.Barrier(N, timeout=3.0)  # needs N at once: N - 1 threads cannot
-    seen = Concurrency()
-    guards, outcomes = _barrier_callbacks(node, ReentrantCallbackGroup(), barrier, seen)
-    executor = MultiThreadedExecutor(num_threads=N - 1)
-    executor.add_node(node)
-    spinner = Background(executor)
-    try:
-        for guard in guards:
-            guard.trigger()
-        assert wait_until(lambda: len(outcomes) == N, 40.0), outcomes
-    finally:
-        spinner.stop()
+    outcomes, seen = _race_to_barrier(ros.Node("short_handed"), barrier, N - 1)
     assert outcomes == ["broken"] * N
     assert barrier.broken
     assert seen.most <= N - 1
