@@ -543,7 +543,11 @@ class MultiThreadedExecutor(Executor):
     def __init__(self, num_threads: int | None = None, *, context: Context | None = None) -> None:
         super().__init__(context=context)
         if num_threads is not None and num_threads < 1:
-            raise ValueError(f"MultiThreadedExecutor needs num_threads >= 1, got {num_threads}")
+            from rosl.node.errors import ThreadCountError
+
+            raise ThreadCountError(
+                f"MultiThreadedExecutor needs num_threads >= 1, got {num_threads}"
+            )
         self.num_threads = num_threads or _default_threads()
         self._rotate = True
         self._pool = ThreadPoolExecutor(self.num_threads, thread_name_prefix="rosl-executor")

@@ -44,5 +44,9 @@ class TimerPeriodError(NodeError, ValueError):
     """A timer period that is not a finite number of seconds > 0 (or past int64 nanoseconds)."""
 
 
+class ThreadCountError(NodeError, ValueError):
+    """An executor was given fewer than one thread."""
+
+
 class NotInitializedError(NodeError):
     """rosl.init() was not called (or the context is shut down)."""

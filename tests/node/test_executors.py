@@ -1083,3 +1083,10 @@ def test_a_node_removed_between_spins_runs_nothing_already_found(ros):
     b.create_timer(0.001, lambda: ran.append("b"))
     executor.spin_once(timeout_sec=BOUND)
     assert ran[1:] == ["b"], ran
+
+
+def test_a_thread_count_below_one_is_refused_as_a_user_error(ros):
+    from rosl.errors import RoslError  # rosl run reports these in one line, no traceback
+
+    with pytest.raises(RoslError, match=r"num_threads >= 1, got 0"):
+        MultiThreadedExecutor(num_threads=0)
