@@ -13,16 +13,24 @@ split before the message that would make it longer than ``max_bag_duration`` (by
 or once it has reached ``max_bag_size`` bytes (counted as messages are written). A topic is
 recorded with the first type seen on it; messages of another type on it are counted and
 reported, never written (``selection.py``).
+
+Messages of a topic the recorder cannot name yet (discovery has not shown its publisher) or
+whose schema is still being read are held until it can, for at most ``PENDING_LIMIT_S``, and
+within ``PENDING_MAX`` messages and ``PENDING_BYTES`` bytes (the buffers they keep alive): a
+flood of datagrams on topics nobody announces costs a bounded amount of memory. What does not
+fit, or waits too long, is counted and reported when the recording stops.
 """
 
 from __future__ import annotations
 
 import contextlib
+import mmap
 import os
 import sys
 import time
+from collections import deque
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO, NamedTuple
 
 from rosl.bag import metadata
 from rosl.bag.errors import BagError
@@ -39,7 +47,9 @@ if TYPE_CHECKING:
     from rosl.node.participant import Participant
 
 FLUSH_EVERY_S = 1.0
-PENDING_MAX = 20000
+PENDING_MAX = 20000  # messages held while their topic cannot be named yet
+PENDING_BYTES = 32 * 1024 * 1024  # the bytes they may keep alive (see _Pending)
+HELD_OVERHEAD = 512  # bytes per held message besides its buffer: tuple, view, bookkeeping
 MESSAGE_RECORD = 31  # bytes of an MCAP message record besides its data
 _SUBSCRIPTION_QOS = {"reliability": "RELIABLE", "durability": "VOLATILE", "history": "KEEP_LAST",
                      "depth": 1000}  # fmt: skip
@@ -114,8 +124,7 @@ class Recorder:
         self._generation = -1
         self._synced = -1
         self._node_index = 0
-        self._pending: list[Delivery] = []
-        self._pending_since: dict[tuple[int, int], float] = {}
+        self._pending = _Pending(PENDING_MAX, PENDING_BYTES)
         self._schemas: Schemas | None = None
         self._failure: BagError | None = None  # the first write the disk refused
         self._last_flush = time.monotonic()
@@ -217,6 +226,11 @@ class Recorder:
                 if wall - self._last_flush >= FLUSH_EVERY_S:
                     self._flush()
                     self._last_flush = wall
+
+    @property
+    def held_bytes(self) -> int:
+        """Bytes kept alive by the messages held until their topic is known (<= PENDING_BYTES)."""
+        return self._pending.bytes
 
     def run(self, until: Callable[[], bool]) -> None:
         """Record until ``until()`` is true."""
@@ -347,10 +361,16 @@ class Recorder:
     # --- messages ----------------------------------------------------------------------------
 
     def _on_delivery(self, delivery: Delivery) -> None:
+        if not self._take(delivery):
+            self.dropped_unknown += self._pending.add(delivery, time.monotonic())
+
+    def _take(self, delivery: Delivery) -> bool:
+        """Record a delivery (or leave it out on purpose); False while it must be held."""
         if delivery.kind == Kind.DATA:
-            self._record_data(delivery)
-        elif self.services and delivery.kind in (Kind.REQUEST, Kind.RESPONSE):
-            self._record_service(delivery)
+            return self._record_data(delivery)
+        if self.services and delivery.kind in (Kind.REQUEST, Kind.RESPONSE):
+            return self._record_service(delivery)
+        return True
 
     def _resolve(self, delivery: Delivery, kinds: tuple[str, ...]) -> tuple[str, str, str] | None:
         assert self.participant is not None
@@ -369,32 +389,30 @@ class Recorder:
             return None
         return found
 
-    def _record_data(self, delivery: Delivery) -> None:
+    def _record_data(self, delivery: Delivery) -> bool:
         found = self._resolve(delivery, (PUBLISHER, SUBSCRIPTION))
         if found is None:
-            self._hold(delivery)
-            return
+            return False
         name, type_name, _ = found
         if not self.selection.wanted(name) or self._other_type(name, type_name, delivery):
-            return
+            return True
         topic = self._subscribe(name, type_name)
         if topic is None:
-            self._hold(delivery)
-            return
+            return False
         self._write(name, topic, delivery, bytes(delivery.payload))
+        return True
 
-    def _record_service(self, delivery: Delivery) -> None:
+    def _record_service(self, delivery: Delivery) -> bool:
         from rosl.idl.errors import InterfaceError
         from rosl.node.service_events import event_from_delivery, event_topic, event_type_name
 
         found = self._resolve(delivery, (SERVER, CLIENT))
         if found is None:
-            self._hold(delivery)
-            return
+            return False
         service, service_type, _ = found
         name = event_topic(service)
         if self.selection.excluded(name):
-            return
+            return True
         try:
             event = event_from_delivery(delivery, service_type)
         except InterfaceError:
@@ -402,18 +420,18 @@ class Recorder:
                 self.skipped_types.add(service_type)
                 self._log(f"[WARN] [rosl_recorder]: service type {service_type} is unknown here; "
                           f"events of {service} are not recorded")  # fmt: skip
-            return
+            return True
         if event is None:
-            return
+            return True
         from rosl.idl import registry
 
         if self._other_type(name, event_type_name(service_type), delivery):
-            return
+            return True
         topic = self._subscribe(name, event_type_name(service_type), qos={"depth": 10})
         if topic is None:
-            self._hold(delivery)
-            return
+            return False
         self._write(name, topic, delivery, registry.store().serialize(event))
+        return True
 
     def _write(self, name: str, topic: _Topic, delivery: Delivery, data: bytes) -> None:
         current = self._file
@@ -568,27 +586,10 @@ class Recorder:
         """The types of the graph's wanted topics (and services) not yet recorded."""
         return {type_name for _, type_name, _ in self._unrecorded()}
 
-    def _hold(self, delivery: Delivery) -> None:
-        key = (delivery.topic, delivery.type)
-        self._pending_since.setdefault(key, time.monotonic())
-        if len(self._pending) < PENDING_MAX:
-            self._pending.append(delivery)
-        else:
-            self.dropped_unknown += 1
-
     def _retry_pending(self, now: float) -> None:
-        waiting, self._pending = self._pending, []
-        for delivery in waiting:
-            self._on_delivery(delivery)
-        still = {(d.topic, d.type) for d in self._pending}
-        for key in list(self._pending_since):
-            if key not in still:
-                del self._pending_since[key]
-            elif now - self._pending_since[key] > PENDING_LIMIT_S:
-                before = len(self._pending)
-                self._pending = [d for d in self._pending if (d.topic, d.type) != key]
-                self.dropped_unknown += before - len(self._pending)
-                del self._pending_since[key]
+        """Record the held messages whose topic is known now; drop those held too long."""
+        self._pending.retry(self._take)
+        self.dropped_unknown += self._pending.expire(now, PENDING_LIMIT_S)
 
 
 def _arrival_free_order(delivery: Delivery) -> tuple[int, int, int, bytes]:
@@ -601,3 +602,115 @@ class _Ignore:
 
     def deliver(self, delivery: Delivery) -> None:
         """Unused: the recorder reads through ``poll(sink=...)``."""
+
+
+class _Held(NamedTuple):
+    delivery: Delivery
+    key: tuple[int, int]  # (topic hash, type hash)
+    buffer: int  # id() of the buffer its payload keeps alive (alive while held: unique)
+
+
+class _Pending:
+    """Messages held until their topic (or its schema) is known, oldest first, bounded.
+
+    A held payload is a view of the datagram it came in (or of a reassembled buffer) and keeps
+    that whole buffer alive, so the byte bound counts each buffer once, whole, however many held
+    messages share it (the messages of a coalesced datagram), plus ``HELD_OVERHEAD`` per
+    message. Counting only each message's own bytes would let a sender keep one small message of
+    each of many large batches (its stamps decide which are evicted first) and hold far more.
+
+    When a new message does not fit, the oldest held messages are dropped first, whatever their
+    topic. A topic about to be announced has its messages among the newest: they survive a
+    flood of strangers' topics unless the flood alone outgrows the bound in the moment before
+    the announcement, and nothing can keep them then. The other choices are worse: refusing
+    new messages when full lets a flood that came first shut out the real topic until its
+    entries age out; a per-topic share does not help, because a flood of random names gives
+    every stranger a topic of its own while the real topic, with its several messages, is the
+    biggest holder and would lose first.
+    """
+
+    def __init__(self, max_count: int, max_bytes: int) -> None:
+        self.max_count = max_count
+        self.max_bytes = max_bytes
+        self.held: deque[_Held] = deque()
+        self.since: dict[tuple[int, int], float] = {}  # only keys with messages held
+        self.counts: dict[tuple[int, int], int] = {}
+        self.buffers: dict[int, list[int]] = {}  # id -> [messages holding it, its size]
+        self.bytes = 0  # the buffers counted once each, plus the overhead per message
+
+    def __len__(self) -> int:
+        return len(self.held)
+
+    def add(self, delivery: Delivery, now: float) -> int:
+        """Hold a message; return how many messages were dropped to bound the hold."""
+        buffer, size = _retained(delivery.payload)
+        if HELD_OVERHEAD + size > self.max_bytes:  # bigger than the whole hold
+            return 1
+        ident = id(buffer)
+        dropped = 0
+        while self.held and (
+            len(self.held) >= self.max_count
+            or self.bytes + HELD_OVERHEAD + (0 if ident in self.buffers else size) > self.max_bytes
+        ):
+            self._release(self.held.popleft())
+            dropped += 1
+        key = (delivery.topic, delivery.type)
+        self.held.append(_Held(delivery, key, ident))
+        self.since.setdefault(key, now)
+        self.counts[key] = self.counts.get(key, 0) + 1
+        holders = self.buffers.get(ident)
+        if holders is None:
+            self.buffers[ident] = [1, size]
+            self.bytes += size
+        else:
+            holders[0] += 1
+        self.bytes += HELD_OVERHEAD
+        return dropped
+
+    def retry(self, take: Callable[[Delivery], bool]) -> None:
+        """Give every held message to ``take`` in order; keep those it refuses, in order."""
+        for _ in range(len(self.held)):
+            entry = self.held[0]
+            if take(entry.delivery):
+                self._release(self.held.popleft())
+            else:
+                self.held.rotate(-1)
+
+    def expire(self, now: float, limit: float) -> int:
+        """Drop the messages of topics held for more than ``limit`` seconds; return how many."""
+        old = {key for key, since in self.since.items() if now - since > limit}
+        if not old:
+            return 0
+        kept: deque[_Held] = deque()
+        for entry in self.held:
+            if entry.key in old:
+                self._release(entry)
+            else:
+                kept.append(entry)
+        dropped = len(self.held) - len(kept)
+        self.held = kept
+        return dropped
+
+    def _release(self, entry: _Held) -> None:
+        left = self.counts[entry.key] - 1
+        if left:
+            self.counts[entry.key] = left
+        else:
+            del self.counts[entry.key]
+            del self.since[entry.key]
+        holders = self.buffers[entry.buffer]
+        holders[0] -= 1
+        self.bytes -= HELD_OVERHEAD
+        if not holders[0]:
+            del self.buffers[entry.buffer]
+            self.bytes -= holders[1]
+
+
+def _retained(payload: memoryview | bytearray | mmap.mmap) -> tuple[object, int]:
+    """The buffer a payload keeps alive, and its size in bytes."""
+    if not isinstance(payload, memoryview):
+        return payload, len(payload)
+    base = payload.obj
+    if isinstance(base, (bytes, bytearray, mmap.mmap)):
+        return base, len(base)
+    return (payload if base is None else base), payload.nbytes  # at least the view itself
