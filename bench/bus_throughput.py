@@ -5,8 +5,9 @@ Prints, per payload size, delivered messages/s and MB/s for plain Python multica
 Reader draining the topic's channel in the subscriber), publisher flat out (saturation), with
 the ratio to the baseline and the loss. Then, for 64 B and 1 KB, the same with the writer
 coalescing small messages (opt-in: ``create_publisher(..., coalesce=True)`` or
-``ROSL_COALESCE=1``). Last, the publisher paced at 80 % of the capacity measured above: the
-loss there must be 0.
+``ROSL_COALESCE=1``). Then the publisher paced at 80 % of the capacity measured above: the
+loss there must be 0. Last, the cost of authentication: the bus signed (the default) against
+the bus with ``ROSL_KEY=none``, interleaved run by run, as a ratio (aim: >= 0.9).
 
     python bench/bus_throughput.py [--count N] [--runs R]
 """
@@ -14,10 +15,16 @@ loss there must be 0.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
 import time
+from typing import TYPE_CHECKING
 
 from _harness import BENCH_DOMAIN, finish, raw_receiver, raw_sender, spawn
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
 
 SIZES = [64, 1024, 60000, 1048576]
 GROUP, PORT = f"239.255.{BENCH_DOMAIN}.9", 17400 + BENCH_DOMAIN + 1  # a port rosl does not use
@@ -109,6 +116,23 @@ def pub_coalesced(count: int, size: int) -> None:
     pub_bus(count, size, coalesce=True)
 
 
+@contextlib.contextmanager
+def key(value: str | None) -> Iterator[None]:
+    """Run the bus (both processes) with ``ROSL_KEY`` set to ``value`` (None: the default)."""
+    before = os.environ.get("ROSL_KEY")
+    if value is None:
+        os.environ.pop("ROSL_KEY", None)
+    else:
+        os.environ["ROSL_KEY"] = value
+    try:
+        yield
+    finally:
+        if before is None:
+            os.environ.pop("ROSL_KEY", None)
+        else:
+            os.environ["ROSL_KEY"] = before
+
+
 def measure(kind: str, count: int, size: int, rate: float = 0.0) -> tuple[float, float]:
     sub = "raw" if kind == "raw" else "bus"
     child = spawn([__file__, f"sub_{sub}", str(count), str(size)])
@@ -169,6 +193,19 @@ def main() -> None:
         rate, loss = max(results, key=lambda r: r[1])  # the worst run
         print(f"{size:>9} {offered:>10.0f} {rate:>10.0f} {loss:>7.2f}")
     print("paced: the worst of the runs; offered = 80 % of the flat-out rate measured above")
+    print(f"\n{'mac cost':>9} {'signed/s':>10} {'unsigned/s':>10} {'ratio':>6}")
+    for kind, size in (("bus", 64), ("bus", 1024), ("bus", 60000), ("coalesced", 64)):
+        count = max(200, min(args.count, int(4e9 / max(size, 1) / 10)))
+        signed, unsigned = [], []
+        for _ in range(args.runs):  # interleaved: both see the same machine
+            with key(None):
+                signed.append(measure(kind, count, size)[0])
+            with key("none"):
+                unsigned.append(measure(kind, count, size)[0])
+        a, b = sorted(signed)[len(signed) // 2], sorted(unsigned)[len(unsigned) // 2]
+        label = f"{size}{'c' if kind == 'coalesced' else ''}"
+        print(f"{label:>9} {a:>10.0f} {b:>10.0f} {a / b if b else 0.0:>6.2f}")
+    print("mac cost: msg/s signed (default key) / with ROSL_KEY=none; c = coalesced")
 
 
 if __name__ == "__main__":

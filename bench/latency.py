@@ -4,7 +4,8 @@ The raw baseline bounces 64 B datagrams between two plain multicast sockets; ros
 std_msgs/msg/UInt8MultiArray through publishers, subscriptions and spin_once (serialize,
 send, receive, decode, callback, on both sides). Prints median and p99 in microseconds and
 the ratios, each run measuring raw then rosl back to back, several runs, on a quiet machine
-and with a busy loop on the other core.
+and with a busy loop on the other core. Last, the cost of authentication per hop: rosl signed
+(the default) against rosl with ``ROSL_KEY=none``, interleaved (aim: <= 5 us per hop).
 
     python bench/latency.py [--rounds N] [--size BYTES] [--runs R]
 """
@@ -12,6 +13,7 @@ and with a busy loop on the other core.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -135,6 +137,40 @@ def measure(runs: int, rounds: int, size: int, label: str) -> None:
     )
 
 
+def rosl_only(rounds: int, size: int, key: str | None) -> tuple[float, float]:
+    """rosl's (median, p99) with ``ROSL_KEY`` set to ``key`` in both processes (None: default)."""
+    before = os.environ.pop("ROSL_KEY", None)
+    if key is not None:
+        os.environ["ROSL_KEY"] = key
+    try:
+        child = spawn([__file__, "rosl_pong"])
+        ours = stats(rosl_ping(rounds, size))
+        child.terminate()
+        finish(child)
+    finally:
+        os.environ.pop("ROSL_KEY", None)
+        if before is not None:
+            os.environ["ROSL_KEY"] = before
+    return ours
+
+
+def measure_mac(runs: int, rounds: int, size: int) -> None:
+    """Signed against unsigned, interleaved; the cost per hop is half the round trip's."""
+    costs = []
+    for _ in range(runs):
+        signed = rosl_only(rounds, size, None)
+        unsigned = rosl_only(rounds, size, "none")
+        costs.append((signed[0] - unsigned[0]) / 2)
+        print(
+            f"  mac        signed {signed[0]:7.1f} / {signed[1]:7.1f}   unsigned "
+            f"{unsigned[0]:7.1f} / {unsigned[1]:7.1f}   per hop {costs[-1]:+6.1f} us",
+            flush=True,
+        )
+    print(
+        f"mac: median of {runs} runs, cost per hop {statistics.median(costs):+.1f} us (target <= 5)"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--rounds", type=int, default=2000)
@@ -150,6 +186,7 @@ def main() -> None:
     finally:
         busy.kill()
         busy.wait()
+    measure_mac(args.runs, args.rounds, args.size)
 
 
 if __name__ == "__main__":

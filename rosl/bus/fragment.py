@@ -3,13 +3,19 @@
 Every fragment but the last carries exactly ``chunk`` bytes, so a fragment's offset is
 ``index * len(payload)`` (the last one's is ``total - len(payload)``): fragments may arrive in
 any order. Incomplete messages are dropped after ``max_age_ns`` or when a newer message from
-the same endpoint completes, and counted; memory is capped (a burst of garbage headers cannot
-make the process allocate without bound).
+the same endpoint starts, and counted. Memory is bounded by one budget for all partial
+messages of a reader (``ROSL_REASSEMBLY_MB``, 64 MiB by default), counted as the memory the
+buffers really hold: small buffers whole, big ones (lazily mapped) as their fragments arrive.
+When a fragment would pass the budget the oldest partial messages are evicted (counted); a
+message bigger than the whole budget is refused with one warning saying how to raise it. So a
+flood of fragments from made-up senders costs at most the budget, and only for a second.
 """
 
 from __future__ import annotations
 
 import mmap
+import os
+import sys
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -20,8 +26,18 @@ if TYPE_CHECKING:
     from rosl.bus.header import Header
 
 MAX_MESSAGE_SIZE = 256 * 1024 * 1024  # bytes; larger claims are foreign or broken
-MAX_PENDING_BYTES = 512 * 1024 * 1024  # all partial messages of one process together
+BUDGET_MB = 64  # all partial messages of one reader together (ROSL_REASSEMBLY_MB)
 MAX_AGE_NS = 1_000_000_000
+
+
+def budget_from_env() -> int:
+    """The reassembly budget in bytes (``ROSL_REASSEMBLY_MB``; a bad value: the default)."""
+    text = os.environ.get("ROSL_REASSEMBLY_MB", "").strip()
+    try:
+        megabytes = float(text) if text else BUDGET_MB
+    except ValueError:
+        megabytes = BUDGET_MB
+    return int(max(1.0, megabytes) * 1024 * 1024)
 
 
 def split(
@@ -49,20 +65,29 @@ class _Partial:
     buffer: bytearray | mmap.mmap
     count: int
     started_ns: int
+    held: int  # bytes of memory it holds (budgeted)
     received: set[int] = field(default_factory=set)
 
 
 class Reassembler:
     """Collects fragments into whole messages, keyed by (sender, endpoint, kind, seq)."""
 
-    def __init__(self, max_age_ns: int = MAX_AGE_NS, max_pending: int = MAX_PENDING_BYTES) -> None:
+    def __init__(self, max_age_ns: int = MAX_AGE_NS, budget: int | None = None) -> None:
         self.max_age_ns = max_age_ns
-        self.max_pending = max_pending
+        self.budget = budget_from_env() if budget is None else budget
         self.incomplete = 0  # messages dropped with fragments missing
         self.malformed = 0  # fragments that contradict their own header
+        self.evicted = 0  # partial messages dropped to stay within the budget
+        self.oversize = 0  # fragments of messages bigger than the whole budget
         self._partial: dict[tuple[int, int, int, int], _Partial] = {}
         self._latest: dict[tuple[int, int, int], tuple[int, int, int, int]] = {}
-        self._pending = 0
+        self._held = 0
+        self._warned = False
+
+    @property
+    def held(self) -> int:
+        """Bytes of memory the partial messages hold."""
+        return self._held
 
     def add(self, header: Header, payload: memoryview, now_ns: int) -> bytearray | mmap.mmap | None:
         """Add one fragment; return the whole payload when this completed it."""
@@ -75,8 +100,10 @@ class Reassembler:
         key = (header.sender, header.endpoint, header.kind, header.seq)
         partial = self._partial.get(key)
         if partial is None:
-            self._start(key, total, count, now_ns)
-            partial = self._partial[key]
+            if total > self.budget:
+                self._too_big(total)
+                return None
+            partial = self._start(key, total, count, now_ns)
         elif partial.count != count or len(partial.buffer) != total:
             self.malformed += 1
             return None
@@ -86,6 +113,10 @@ class Reassembler:
         if offset < 0 or offset + size > total:
             self.malformed += 1
             return None
+        if isinstance(partial.buffer, mmap.mmap):  # lazily mapped: memory grows as it fills
+            self._make_room(size, key)
+            partial.held += size
+            self._held += size
         partial.buffer[offset : offset + size] = payload
         partial.received.add(index)
         if len(partial.received) < count:
@@ -93,20 +124,45 @@ class Reassembler:
         self._finish(key)
         return partial.buffer
 
-    def _start(self, key: tuple[int, int, int, int], total: int, count: int, now_ns: int) -> None:
+    def _too_big(self, total: int) -> None:
+        self.oversize += 1
+        if not self._warned:
+            self._warned = True
+            print(
+                f"rosl: warning: dropped a message of {total / 1048576:.1f} MiB: it is bigger "
+                f"than the reassembly budget ({self.budget / 1048576:.0f} MiB); raise it with "
+                "ROSL_REASSEMBLY_MB",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    def _start(
+        self, key: tuple[int, int, int, int], total: int, count: int, now_ns: int
+    ) -> _Partial:
         stream = key[:3]
         older = self._latest.get(stream)
         if older is not None and older in self._partial:
             self._drop(older)  # a newer message started: the old one will not complete
         self._latest[stream] = key
-        while self._partial and self._pending + total > self.max_pending:
-            self._drop(next(iter(self._partial)))
-        self._partial[key] = _Partial(_buffer(total), count, now_ns)
-        self._pending += total
+        buffer = _buffer(total)
+        held = 0 if isinstance(buffer, mmap.mmap) else total
+        self._make_room(held, key)
+        partial = self._partial[key] = _Partial(buffer, count, now_ns, held)
+        self._held += held
+        return partial
+
+    def _make_room(self, size: int, keep: tuple[int, int, int, int]) -> None:
+        """Evict the oldest partial messages (not ``keep``) until ``size`` more bytes fit."""
+        while self._held + size > self.budget:
+            oldest = next((k for k in self._partial if k != keep), None)
+            if oldest is None:
+                return  # only the message being filled is left: it fits (checked at start)
+            self._finish(oldest)
+            self.evicted += 1
 
     def _finish(self, key: tuple[int, int, int, int]) -> None:
         partial = self._partial.pop(key)
-        self._pending -= len(partial.buffer)
+        self._held -= partial.held
         if self._latest.get(key[:3]) == key:  # nothing of that stream is pending any more
             del self._latest[key[:3]]
 

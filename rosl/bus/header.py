@@ -1,10 +1,16 @@
 """The fixed header every rosl datagram starts with (48 bytes, little endian).
 
+A datagram is this header, the payload, and — when the sender has a key (see ``auth.py``)
+and sets :attr:`Flags.SIGNED` — a 16-byte MAC over both. ``sender`` is drawn at random when a
+process starts: it is the session id that makes a restarted process a new stream, and with
+``endpoint`` and ``seq`` it names every message once (duplicates and replays are dropped by
+the receiver's sliding window, see ``wire.py``). ``stamp`` is when the datagram was sent.
+
 ========  =====  ==========================================================================
 field     bytes  meaning
 ========  =====  ==========================================================================
 magic     2      ``b"RL"``: anything else is foreign traffic and dropped
-version   1      protocol version (1)
+version   1      protocol version (2)
 kind      1      :class:`Kind`
 flags     1      :class:`Flags`
 -         1      reserved (0)
@@ -16,7 +22,7 @@ type      4      FNV-1a 32 hash of the type name (mismatches are dropped, not de
 index     2      this fragment's index
 endpoint  2      the sending endpoint's number within its process
 total     4      the whole message's payload size
-stamp     8      send time, integer nanoseconds since the epoch
+stamp     8      send time, integer nanoseconds since the epoch (sender's clock)
 ========  =====  ==========================================================================
 """
 
@@ -27,7 +33,7 @@ import struct
 from typing import NamedTuple
 
 MAGIC = b"RL"
-VERSION = 1
+VERSION = 2  # 2: the MAC trailer
 HEADER = struct.Struct("<2sBBBxHQIQIHHIq")
 HEADER_SIZE = HEADER.size
 # Addressed datagrams (a service response, a history replay) start their payload with this:
@@ -59,6 +65,7 @@ class Flags(enum.IntFlag):
     ADDRESSED = 1  # the payload starts with an ADDRESS record
     LOCKSTEP = 2  # sent by a lock-stepped simulator: subscribers answer when they handled it
     BATCH = 4  # the payload is several small messages of one endpoint (see coalesce.py)
+    SIGNED = 8  # the datagram ends with a MAC (see auth.py)
 
 
 class Header(NamedTuple):

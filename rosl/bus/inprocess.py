@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import collections
 import threading
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
+from rosl.bus import auth as keys
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
     from rosl.bus.wire import Delivery
 
@@ -46,7 +48,8 @@ def _hub(domain: int) -> _Hub:
 class InProcessTransport:
     """The process-local bus of one domain."""
 
-    def __init__(self, domain: int) -> None:
+    def __init__(self, domain: int, auth: Auth | Literal["env"] | None = "env") -> None:
+        self.auth = keys.load(domain) if auth == "env" else auth  # signed as on the wire
         self.name = "the in-process bus"
         self.fix_hint = "the receiver must join channel 0 before the first send"
         self.domain = domain
@@ -67,7 +70,7 @@ class InProcessTransport:
 
     def receiver(self) -> InProcessReceiver:
         """A new receiver on this domain's hub."""
-        receiver = InProcessReceiver(self._hub)
+        receiver = InProcessReceiver(self._hub, self.auth)
         self._receivers.append(receiver)
         return receiver
 
@@ -85,8 +88,8 @@ class InProcessTransport:
 class InProcessReceiver:
     """Queues per channel, waited on with a condition variable."""
 
-    def __init__(self, hub: _Hub) -> None:
-        self.reader = Reader()
+    def __init__(self, hub: _Hub, auth: Auth | None = None) -> None:
+        self.reader = Reader(auth)
         self._hub = hub
         self._queues: dict[int, collections.deque[bytes]] = {}
         self._ready = threading.Condition()

@@ -18,8 +18,9 @@ import struct
 import sys
 import threading
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
+from rosl.bus import auth as keys
 from rosl.bus.errors import BusError
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.transport import CHANNELS
@@ -28,6 +29,7 @@ from rosl.bus.wire import Reader
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
     from rosl.bus.wire import Delivery
 
@@ -37,6 +39,7 @@ BASE_PORT = 17400
 MAX_DOMAIN = 232
 RCVBUF_WANTED = 8 * 1024 * 1024
 RCVBUF_WARN_BELOW = 1024 * 1024
+DRAIN_LIMIT = 1024  # datagrams read from one socket per poll
 IP_MULTICAST_ALL = 49  # linux/in.h; not exported by the socket module
 LOOPBACK = "127.0.0.1"
 FIX_HINT = (
@@ -194,8 +197,16 @@ def _check_rcvbuf(sock: socket.socket) -> None:
 class MulticastTransport:
     """UDP multicast on one domain: one sending socket, receivers with sockets of their own."""
 
-    def __init__(self, addressing: Addressing) -> None:
+    def __init__(self, addressing: Addressing, auth: Auth | Literal["env"] | None = "env") -> None:
+        """Open the sending socket.
+
+        Args:
+            addressing: the domain's groups and port, and the interface.
+            auth: the key datagrams are signed and checked with; ``"env"``: as the
+                environment says (:func:`rosl.bus.auth.load`); None: no authentication.
+        """
         self.addressing = addressing
+        self.auth = keys.load(addressing.domain) if auth == "env" else auth
         self.name = "multicast"
         self.fix_hint = FIX_HINT
         self.domain = addressing.domain
@@ -227,7 +238,7 @@ class MulticastTransport:
 
     def receiver(self) -> MulticastReceiver:
         """A new receiver (its sockets are opened as it joins channels)."""
-        receiver = MulticastReceiver(self.addressing)
+        receiver = MulticastReceiver(self.addressing, self.auth)
         with self._lock:
             self._receivers.append(receiver)
         return receiver
@@ -260,9 +271,9 @@ class MulticastTransport:
 class MulticastReceiver:
     """Channel sockets read with ``select``, woken through a pipe."""
 
-    def __init__(self, addressing: Addressing) -> None:
+    def __init__(self, addressing: Addressing, auth: Auth | None = None) -> None:
         self.addressing = addressing
-        self.reader = Reader()
+        self.reader = Reader(auth)
         self._sockets: dict[int, socket.socket] = {}
         self._lock = threading.Lock()
         self._wake_read, self._wake_write = os.pipe()
@@ -306,8 +317,9 @@ class MulticastReceiver:
         for item in ready:
             if isinstance(item, socket.socket):
                 drained += 1
-                while drain(item.recv, out):
-                    pass
+                # bounded: a sender faster than we parse must not grow ``out`` without end;
+                # what is left stays in the socket for the next poll
+                drain(item.recv, out, DRAIN_LIMIT)
             else:
                 with contextlib.suppress(OSError):
                     while os.read(self._wake_read, 4096):

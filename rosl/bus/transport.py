@@ -23,6 +23,7 @@ from rosl.bus.errors import BusError
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from rosl.bus.auth import Auth
     from rosl.bus.pacing import Pacer
     from rosl.bus.wire import Delivery, Reader
 
@@ -69,6 +70,7 @@ class Transport(Protocol):
     domain: int
     max_datagram: int  # the largest datagram send() takes, header included
     pacer: Pacer  # paces fragmented messages so receivers keep up
+    auth: Auth | None  # the domain key datagrams are signed and checked with (None: off)
 
     def send(self, channel: int, parts: Sequence[Buffer]) -> None:
         """Send one datagram made of ``parts`` to every receiver of ``channel``."""

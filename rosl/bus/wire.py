@@ -1,20 +1,36 @@
-"""Messages ↔ datagrams: headers, sequence numbers, fragments, early filtering, loss counts.
+"""Messages ↔ datagrams: headers, MACs, sequence windows, fragments, early filtering, loss.
 
 A :class:`Writer` sends the messages of one endpoint (a publisher, a service client or
-server). A :class:`Reader` turns a receiver's datagrams into deliveries: foreign datagrams and
-topics nobody in the process wants are dropped after the header is read, fragments are
-reassembled, and each publisher stream's sequence numbers are checked so every gap is counted
-— loss is never silent. Callbacks run on the thread that polls; nothing is handed off.
+server), signed when the transport has a key. A :class:`Reader` turns a receiver's datagrams
+into deliveries, and is where strangers' traffic stops:
+
+* foreign, unsigned or wrongly signed datagrams are dropped (and counted) before anything
+  else is read; so are topics nobody in the process wants;
+* every stream — one endpoint of one process start (the sender id is drawn per start), and
+  for addressed datagrams one target — keeps a sliding window over its sequence numbers: a
+  message seen before is never delivered twice (duplicates, replays), and a gap is counted as
+  loss only when it is at most :data:`LOSS_WINDOW` long; a bigger jump starts a new segment
+  of the stream (logged once), so no single datagram can poison the loss count. A late
+  message inside the window takes its gap back out of the loss count, so counts stay exact;
+* a datagram outside its stream's window, or opening a stream, is taken only if its stamp
+  is newer than anything that stream sent before and within :data:`FRESH_NS` of this clock:
+  old datagrams replayed later are dropped as stale;
+* state is bounded: at most :data:`MAX_STREAMS` streams (silent ones are retired first into a
+  bounded table that keeps replay protection), and fragments share one reassembly budget.
+
+Callbacks run on the thread that polls; nothing is handed off.
 """
 
 from __future__ import annotations
 
 import itertools
+import sys
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from rosl.bus import header as hdr
+from rosl.bus.auth import MAC_SIZE
 from rosl.bus.coalesce import Batch, split_records
 from rosl.bus.fragment import Reassembler, split
 from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
@@ -24,6 +40,7 @@ if TYPE_CHECKING:
     import mmap
     from collections.abc import Callable
 
+    from rosl.bus.auth import Auth
     from rosl.bus.coalesce import Flusher
     from rosl.bus.transport import Buffer, Transport
 
@@ -33,8 +50,21 @@ _new_tuple = tuple.__new__  # builds a Delivery without its Python-level __new__
 _MAGIC = hdr.MAGIC
 _ADDRESSED = int(Flags.ADDRESSED)  # plain ints: enum operators are slow per datagram
 _BATCH = int(Flags.BATCH)
+_SIGNED = int(Flags.SIGNED)
 _DATA = int(Kind.DATA)
 _VERSION = hdr.VERSION
+
+DUP_WINDOW = 1024  # sequence numbers behind the newest that are still told apart
+LOSS_WINDOW = 1 << 16  # a forward gap up to this is loss; a bigger jump starts a new segment
+FRESH_NS = 30_000_000_000  # a stream's first datagram must be stamped this close to our clock
+MAX_STREAMS = 8192  # streams followed at once (each kind of stream has its own table)
+MAX_RETIRED = 16384  # streams forgotten but still protected against replays
+SILENT_NS = 10_000_000_000  # a stream silent this long is retired
+HOUSEKEEPING_NS = 250_000_000
+MAX_JUMP_LOGS = 10
+_FULL = (1 << DUP_WINDOW) - 1
+_MASK32 = 0xFFFFFFFF
+ACCEPTED, JUMPED, DUPLICATE, STALE = 0, -1, 1, 2  # > 0: dropped
 
 
 class Delivery(NamedTuple):
@@ -55,13 +85,60 @@ class Delivery(NamedTuple):
 
 @dataclass(slots=True)
 class StreamStats:
-    """What one subscriber-side process saw of one publisher's stream."""
+    """What one receiving process saw of one stream (a publisher's, for ``DATA``).
+
+    ``last_seq`` is the newest sequence number; bit ``i`` of ``seen`` says whether
+    ``last_seq - i`` arrived (numbers before the stream's first are taken as seen).
+    """
 
     topic: int
     received: int = 0
     lost: int = 0
     last_seq: int = 0
     last_received: int = 0
+    seen: int = _FULL
+    stamp: int = 0  # the newest datagram stamp of the stream (the sender's clock)
+    jumps: int = 0  # new segments started by a jump beyond the windows
+
+
+def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> int:
+    """Place one message in its stream's window: ACCEPTED or JUMPED, else DUPLICATE or STALE.
+
+    Args:
+        stats: the stream.
+        seq: the message's sequence number.
+        stamp: the datagram's (signed) send stamp.
+        now: the receive time (ns).
+        loss: count gaps as lost messages (publisher streams).
+    """
+    result = ACCEPTED
+    step = (seq - stats.last_seq) & _MASK32
+    if 0 < step <= LOSS_WINDOW:
+        if loss:
+            stats.lost += step - 1
+        stats.seen = ((stats.seen << step) | 1) & _FULL
+        stats.last_seq = seq
+    else:
+        back = (stats.last_seq - seq) & _MASK32
+        if back < DUP_WINDOW:
+            bit = 1 << back
+            if stats.seen & bit:
+                return DUPLICATE
+            stats.seen |= bit
+            if loss and stats.lost:
+                stats.lost -= 1  # it was counted lost when the stream went past it
+        elif stamp > stats.stamp:  # far from the window, but newer than all the stream sent
+            stats.last_seq = seq
+            stats.seen = _FULL
+            stats.jumps += 1
+            result = JUMPED
+        else:
+            return STALE
+    if stamp > stats.stamp:
+        stats.stamp = stamp
+    stats.received += 1
+    stats.last_received = now
+    return result
 
 
 class Writer:
@@ -84,12 +161,14 @@ class Writer:
         self.topic = hdr.topic_hash(name)
         self.type = hdr.type_hash(type_name)
         self.channel = channel_of(self.topic) if channel is None else channel
-        self.chunk = transport.max_datagram - HEADER_SIZE
+        self.chunk = transport.max_datagram - HEADER_SIZE - MAC_SIZE
         self._seq = itertools.count(1)
         self.sent = 0
         self.last_seq = 0  # the sequence number of the last message sent
         self.flags = 0  # extra header flags for every message (Flags.LOCKSTEP)
         self.batch: Batch | None = None
+        self.auth: Auth | None = transport.auth
+        self._signed = 0 if self.auth is None else _SIGNED
 
     def coalesce(self, flusher: Flusher, limit: int) -> None:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
@@ -102,10 +181,16 @@ class Writer:
 
     def _send_batch(self, seq: int, stamp: int, records: bytes) -> None:
         head = HEADER.pack(
-            _MAGIC, _VERSION, self.kind, _BATCH, 1, self.sender, seq, self.topic,
-            self.type, 0, self.endpoint, len(records), stamp,
+            _MAGIC, _VERSION, self.kind, _BATCH | self._signed, 1, self.sender, seq,
+            self.topic, self.type, 0, self.endpoint, len(records), stamp,
         )  # fmt: skip
-        self.transport.send(self.channel, [head, records])
+        self._send([head, records])
+
+    def _send(self, parts: list[Buffer]) -> None:
+        """Send one datagram, with its MAC when there is a key."""
+        if self.auth is not None:
+            parts.append(self.auth.mac_parts(parts))
+        self.transport.send(self.channel, parts)
 
     def send(
         self,
@@ -123,7 +208,8 @@ class Writer:
             kind: overrides the writer's kind (e.g. REPLAY for a publisher).
             address: (process, endpoint, correlation) for a message meant for one endpoint.
             seq: reuse a sequence number (a replayed message keeps its original one).
-            stamp: the send time to record (ns); now by default.
+            stamp: the send time to record (ns); now by default. Receivers take a stream's
+                first message only when its stamp is within ``FRESH_NS`` of their clock.
         """
         number = (next(self._seq) if seq is None else seq) & 0xFFFFFFFF
         flags = self.flags
@@ -142,15 +228,19 @@ class Writer:
                     self.last_seq = number
                 return number
             batch.flush()  # what is pending goes first: the stream stays in order
+        flags |= self._signed
         if total <= self.chunk:
             head = HEADER.pack(
                 _MAGIC, _VERSION, kind_value, flags, 1, self.sender, number, self.topic,
                 self.type, 0, self.endpoint, total, when,
             )  # fmt: skip
             if total < _SMALL:
-                self.transport.send(self.channel, [head + bytes(payload)])
+                data = head + bytes(payload)
+                if self.auth is not None:
+                    data += self.auth.mac(data)
+                self.transport.send(self.channel, [data])
             else:
-                self.transport.send(self.channel, [head, payload])
+                self._send([head, payload])
         else:
             pace = self.transport.pacer
             for index, count, view in split(payload, self.chunk):
@@ -159,7 +249,7 @@ class Writer:
                     self.topic, self.type, index, self.endpoint, total, when,
                 )  # fmt: skip
                 pace.spend(len(view))
-                self.transport.send(self.channel, [head, view])
+                self._send([head, view])
         self.sent += 1
         if seq is None:
             self.last_seq = number
@@ -169,15 +259,30 @@ class Writer:
 class Reader:
     """Turns a receiver's datagrams into complete :class:`Delivery` records."""
 
-    def __init__(self) -> None:
+    def __init__(self, auth: Auth | None = None) -> None:
+        self.auth = auth
         self.wanted: set[int] = set()  # topic hashes someone in this process listens to
         self.want_all = False  # recorders and monitors take every topic
         self.ignored: set[int] = set()  # topic hashes never taken, even with want_all
         self.foreign = 0  # datagrams that are not rosl's (or from another protocol version)
+        self.unsigned = 0  # rosl datagrams without a MAC (a sender with ROSL_KEY=none)
+        self.forged = 0  # rosl datagrams whose MAC is wrong (another key: another user)
         self.unwanted = 0  # rosl datagrams of topics nobody here listens to
-        self.streams: dict[tuple[int, int], StreamStats] = {}
+        self.duplicates = 0  # messages seen before (resent or replayed)
+        self.stale = 0  # datagrams too old for their stream (replays), or stamped far off
+        self.retired = 0  # streams forgotten (silent, evicted, or their process said bye)
+        self.streams: dict[tuple[int, int], StreamStats] = {}  # publishers: (process, endpoint)
+        # every other stream: (process, endpoint, kind, target process, target endpoint)
+        self.others: dict[tuple[int, ...], StreamStats] = {}
         self.reassembler = Reassembler()
-        self._next_expiry = 0
+        self.log: Callable[[str], None] = _log
+        self._retired: dict[tuple[int, ...], tuple[int, int]] = {}  # key -> (last_seq, stamp)
+        self._folded: dict[int, list[int]] = {}  # topic -> [received, lost] of retired streams
+        self._gone: list[int] = []  # processes that said goodbye, retired at the next look
+        self._next_housekeeping = 0
+        self._jump_logs = 0
+
+    # --- the receive path (per datagram: keep it lean) ----------------------------------------
 
     def drain(self, recv: Callable[[int], bytes], out: list[Delivery], limit: int = 256) -> bool:
         """Read up to ``limit`` ready datagrams with ``recv`` into ``out``.
@@ -190,12 +295,10 @@ class Reader:
             True when the source may hold more (the limit was reached).
         """
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
-        clock, streams = time.time_ns, self.streams
-        if self.reassembler.pending:  # drop (and count) messages whose fragments stopped coming
-            now = clock()
-            if now >= self._next_expiry:
-                self._next_expiry = now + 250_000_000
-                self.reassembler.expire(now)
+        clock, streams, auth = time.time_ns, self.streams, self.auth
+        now = clock()
+        if now >= self._next_housekeeping:
+            self._housekeeping(now)
         for _ in range(limit):
             try:
                 data = recv(65536)
@@ -213,22 +316,42 @@ class Reader:
             if magic != _MAGIC or version != _VERSION or count == 0 or index >= count:
                 self.foreign += 1
                 continue
+            if flags & _SIGNED:
+                size -= MAC_SIZE
+                flags ^= _SIGNED  # a wire detail: deliveries carry the message's flags
+                if auth is not None and not auth.verify(data):
+                    self.forged += 1
+                    continue
+            elif auth is not None:
+                self.unsigned += 1
+                continue
             if (not want_all and topic not in wanted) or topic in ignored:
                 self.unwanted += 1
                 continue
             if flags & _BATCH:
-                self._unbatch(data, kind, flags, sender, endpoint, topic, type_, total, now, out)
+                self._unbatch(data, size, kind, flags, sender, endpoint, topic, type_, total,
+                              stamp, now, out)  # fmt: skip
                 continue
+            stats = None
+            if kind == _DATA:
+                stats = streams.get((sender, endpoint))
+                if stats is None:
+                    stats = self._open(streams, (sender, endpoint), topic, seq, stamp, now)
+                    if stats is None:
+                        continue
+                elif count > 1 and _seen(stats, seq):
+                    self.duplicates += 1  # a fragment of a message delivered already
+                    continue
             if count == 1:
                 if total != size - HEADER_SIZE:
                     self.reassembler.malformed += 1
                     continue
-                payload: memoryview | bytearray | mmap.mmap = memoryview(data)[HEADER_SIZE:]
+                payload: memoryview | bytearray | mmap.mmap = memoryview(data)[HEADER_SIZE:size]
             else:
                 whole = self.reassembler.add(
                     hdr.Header(_MAGIC, version, kind, flags, count, sender, seq, topic, type_,
                                index, endpoint, total, stamp),
-                    memoryview(data)[HEADER_SIZE:],
+                    memoryview(data)[HEADER_SIZE:size],
                     now,
                 )  # fmt: skip
                 if whole is None:
@@ -241,11 +364,21 @@ class Reader:
                     continue
                 address = ADDRESS.unpack_from(payload)
                 payload = memoryview(payload)[ADDRESS_SIZE:]
-            if kind == _DATA:
-                stats = streams.get((sender, endpoint))
+            if stats is None:  # requests, responses, replays, discovery: no loss counted
+                key = (sender, endpoint, kind, *(address or (0, 0))[:2])
+                stats = self.others.get(key)
                 if stats is None:
-                    stats = streams[(sender, endpoint)] = StreamStats(topic, last_seq=seq - 1)
-                _advance(stats, seq, now)
+                    stats = self._open(self.others, key, topic, seq, stamp, now)
+                    if stats is None:
+                        continue
+                verdict = _window(stats, seq, stamp, now, False)
+            else:
+                verdict = _window(stats, seq, stamp, now, True)
+            if verdict:
+                if verdict > 0:
+                    self._refuse(verdict)
+                    continue
+                self._jumped(sender, endpoint, stats)
             out.append(
                 _new_tuple(
                     Delivery,
@@ -269,6 +402,7 @@ class Reader:
     def _unbatch(
         self,
         data: bytes,
+        size: int,
         kind: int,
         flags: int,
         sender: int,
@@ -276,49 +410,166 @@ class Reader:
         topic: int,
         type_: int,
         total: int,
+        stamp: int,
         now: int,
         out: list[Delivery],
     ) -> None:
-        """Split a coalesced datagram into one delivery per message."""
-        if total != len(data) - HEADER_SIZE:
+        """Split a coalesced datagram into one delivery per new message."""
+        if total != size - HEADER_SIZE:
             self.reassembler.malformed += 1
             return
         try:
-            records = split_records(memoryview(data)[HEADER_SIZE:])
+            records = split_records(memoryview(data)[HEADER_SIZE:size])
         except ValueError:
             self.reassembler.malformed += 1
             return
+        if not records:
+            return
         flags &= ~_BATCH
-        stats = None
-        if kind == _DATA and records:  # one publisher's stream: looked up once per batch
-            key = (sender, endpoint)
-            stats = self.streams.get(key)
+        loss = kind == _DATA
+        table: dict[Any, StreamStats] = self.streams if loss else self.others
+        key: tuple[int, ...] = (sender, endpoint) if loss else (sender, endpoint, kind, 0, 0)
+        stats = table.get(key)  # one stream: looked up once per batch
+        if stats is None:
+            stats = self._open(table, key, topic, records[0][0], stamp, now)
             if stats is None:
-                stats = self.streams[key] = StreamStats(topic, last_seq=records[0][0] - 1)
-        for seq, stamp, payload in records:
-            if stats is not None:
-                _advance(stats, seq, now)
-            out.append(
-                _new_tuple(
-                    Delivery,
-                    (kind, sender, endpoint, seq, topic, type_, stamp, now, payload, None, flags),
-                )
-            )
+                return
+        for seq, message_stamp, payload in records:
+            verdict = _window(stats, seq, stamp, now, loss)  # the datagram's stamp is signed
+            if verdict:
+                if verdict > 0:
+                    self._refuse(verdict)
+                    continue
+                self._jumped(sender, endpoint, stats)
+            fields = (kind, sender, endpoint, seq, topic, type_, message_stamp, now, payload,
+                      None, flags)  # fmt: skip
+            out.append(_new_tuple(Delivery, fields))
+
+    # --- streams ---------------------------------------------------------------------------------
+
+    def _open(
+        self,
+        table: dict[Any, StreamStats],
+        key: tuple[int, ...],
+        topic: int,
+        seq: int,
+        stamp: int,
+        now: int,
+    ) -> StreamStats | None:
+        """Start following a stream, or None when its first datagram is stale (a replay)."""
+        retired = self._retired.pop(key, None)
+        if retired is not None:
+            last_seq, last_stamp = retired
+            if stamp <= last_stamp:
+                self._retired[key] = retired
+                self.stale += 1
+                return None
+            stats = StreamStats(topic, last_seq=last_seq, stamp=last_stamp)
+        elif abs(now - stamp) > FRESH_NS:
+            self.stale += 1
+            return None
+        else:
+            stats = StreamStats(topic, last_seq=(seq - 1) & _MASK32)
+        if len(table) >= MAX_STREAMS:
+            self._evict(table, now)
+        table[key] = stats
+        return stats
+
+    def _refuse(self, verdict: int) -> None:
+        if verdict == DUPLICATE:
+            self.duplicates += 1
+        else:
+            self.stale += 1
+
+    def _jumped(self, sender: int, endpoint: int, stats: StreamStats) -> None:
+        """Say once per stream (and a few times per process) that a stream jumped."""
+        if stats.jumps > 1 or self._jump_logs >= MAX_JUMP_LOGS:
+            return
+        self._jump_logs += 1
+        more = "" if self._jump_logs < MAX_JUMP_LOGS else " (further jumps are not logged)"
+        self.log(
+            f"bus: the stream of endpoint {endpoint} of process {sender:016x} jumped to "
+            f"sequence number {stats.last_seq}; loss is counted from there (a forged or "
+            f"corrupted datagram, or more than {LOSS_WINDOW} messages lost at once){more}"
+        )
+
+    def forget(self, sender: int) -> None:
+        """A process said goodbye: retire its streams (at the next look; any thread)."""
+        if len(self._gone) < MAX_RETIRED:  # a reader nobody polls must not grow either
+            self._gone.append(sender)
+
+    def _housekeeping(self, now: int) -> None:
+        """Expire fragments, retire silent streams and those of processes that said bye."""
+        self._next_housekeeping = now + HOUSEKEEPING_NS
+        if self.reassembler.pending:  # drop (and count) messages whose fragments stopped
+            self.reassembler.expire(now)
+        gone, self._gone = set(self._gone), []
+        for table in (self.streams, self.others):
+            for key, stats in list(table.items()):
+                if key[0] in gone or now - stats.last_received > SILENT_NS:
+                    self._retire(table, key)
+
+    def _evict(self, table: dict[Any, StreamStats], now: int) -> None:
+        """Make room in a full table: retire silent streams, else the least recently heard."""
+        for key, stats in list(table.items()):
+            if now - stats.last_received > SILENT_NS:
+                self._retire(table, key)
+        if len(table) >= MAX_STREAMS:
+            by_age = sorted(table.items(), key=lambda item: item[1].last_received)
+            for key, _ in by_age[: MAX_STREAMS // 4]:
+                self._retire(table, key)
+
+    def _retire(self, table: dict[Any, StreamStats], key: tuple[int, ...]) -> None:
+        stats = table.pop(key, None)
+        if stats is None:
+            return
+        self.retired += 1
+        if len(self._retired) >= MAX_RETIRED:
+            del self._retired[next(iter(self._retired))]  # the oldest retirement
+        self._retired[key] = (stats.last_seq, stats.stamp)
+        if table is self.streams and (self.want_all or stats.topic in self.wanted):
+            folded = self._folded.setdefault(stats.topic, [0, 0])
+            folded[0] += stats.received
+            folded[1] += stats.lost
+
+    # --- counts (any thread) ---------------------------------------------------------------------
 
     def lost(self, topic: int | None = None) -> int:
-        """Messages lost (sequence gaps) on all streams, or on one topic's streams."""
-        return sum(s.lost for s in self.streams.values() if topic is None or s.topic == topic)
+        """Messages lost (sequence gaps) on all publisher streams, or on one topic's."""
+        return self._count(1, topic)
 
     def received(self, topic: int | None = None) -> int:
-        """Messages received on all streams, or on one topic's streams."""
-        return sum(s.received for s in self.streams.values() if topic is None or s.topic == topic)
+        """Messages received on all publisher streams, or on one topic's."""
+        return self._count(0, topic)
+
+    def _count(self, field: int, topic: int | None) -> int:
+        # snapshots: the polling thread adds and retires streams while other threads count
+        live = tuple(self.streams.values())
+        folded = tuple(self._folded.items())
+        total = sum(f[1][field] for f in folded if topic is None or f[0] == topic)
+        if field:
+            return total + sum(s.lost for s in live if topic is None or s.topic == topic)
+        return total + sum(s.received for s in live if topic is None or s.topic == topic)
+
+    def dropped(self) -> dict[str, int]:
+        """What this reader refused, by reason (for rosl doctor and the fuzz tests)."""
+        return {
+            "foreign": self.foreign,
+            "unsigned": self.unsigned,
+            "forged": self.forged,
+            "duplicates": self.duplicates,
+            "stale": self.stale,
+            "malformed": self.reassembler.malformed,
+            "incomplete": self.reassembler.incomplete,
+            "evicted": self.reassembler.evicted,
+        }
 
 
-def _advance(stats: StreamStats, seq: int, now: int) -> None:
-    """Count one message of a stream, and the gap before it (loss is never silent)."""
-    step = (seq - stats.last_seq) & 0xFFFFFFFF
-    if 0 < step < 0x80000000:
-        stats.lost += step - 1
-        stats.last_seq = seq
-    stats.received += 1
-    stats.last_received = now
+def _seen(stats: StreamStats, seq: int) -> bool:
+    """Whether a stream already delivered ``seq`` (inside its window)."""
+    back = (stats.last_seq - seq) & _MASK32
+    return back < DUP_WINDOW and bool(stats.seen >> back & 1)
+
+
+def _log(line: str) -> None:
+    print(f"rosl: {line}", file=sys.stderr, flush=True)

@@ -67,6 +67,8 @@ class Discovery:
         self.loopback_ok = threading.Event()
         self.malformed = 0
         self.lockstep = False  # announced: this process answers lock-stepped simulators
+        # told the sender id of every process that said goodbye or whose lease ran out
+        self.on_gone: list[Callable[[int], None]] = []
         self._describe = describe
         self._transport = transport
         self._writer = Writer(
@@ -84,7 +86,7 @@ class Discovery:
         self._pending_replies: list[str] = []  # "querier:qid" we still owe an answer
         self._stopping = False
         self._has_announced = False
-        self._started = time.monotonic()
+        self.started = time.monotonic()  # when discovery began listening
         self._warned = False
         self._thread = threading.Thread(target=self._run, name="rosl-discovery", daemon=True)
 
@@ -168,6 +170,10 @@ class Discovery:
             f"datagram on {transport.describe()}; {transport.fix_hint}"
         )
 
+    def dropped(self) -> dict[str, int]:
+        """What the discovery channel refused so far, by reason (see ``Reader.dropped``)."""
+        return self._reader.dropped()
+
     def send(self, message: dict[str, Any]) -> None:
         """Send another op (e.g. ``replay``) to every process."""
         self._send(message)
@@ -209,7 +215,8 @@ class Discovery:
                     self._announce(replies)
                 except Exception as err:
                     print(f"rosl: discovery: cannot announce: {err}", file=sys.stderr)
-            self.cache.expire(now)
+            for process in self.cache.expire(now):
+                self._gone(process.sender)
             self._check_selftest(now)
             wait = max(0.0, min(self._announce_due - time.monotonic(), 0.5))
             deliveries.clear()
@@ -218,7 +225,7 @@ class Discovery:
                 self._handle(delivery)
 
     def _check_selftest(self, now: float) -> None:
-        if self.loopback_ok.is_set() or self._warned or now - self._started < SELFTEST_S:
+        if self.loopback_ok.is_set() or self._warned or now - self.started < SELFTEST_S:
             return
         self._warned = True
         print(f"rosl: error: {self.selftest_message()}", file=sys.stderr)
@@ -236,13 +243,22 @@ class Discovery:
             if op == "hello":
                 self._on_hello(message, delivery.sender)
             elif op == "bye":
-                self.cache.remove(int(message["sender"], 16))
+                if int(message["sender"], 16) != delivery.sender:
+                    self.malformed += 1  # a process says goodbye for itself only
+                    return
+                self.cache.remove(delivery.sender)
+                self._gone(delivery.sender)
             elif op == "query":
                 self._on_query(message, delivery.sender)
             elif op in self.handlers:
                 self.handlers[op](message)
         except (ValueError, KeyError, TypeError, AttributeError, OverflowError, RecursionError):
             self.malformed += 1  # one bad datagram must never stop discovery
+
+    def _gone(self, sender: int) -> None:
+        self._reader.forget(sender)
+        for callback in self.on_gone:
+            callback(sender)
 
     def _on_hello(self, message: dict[str, Any], sender: int) -> None:
         record = from_json(message["process"], time.monotonic())

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 LEASE_S = 3.5  # a process not heard from for this long is gone
+MAX_PROCESSES = 4096  # processes followed at once: a flood of made-up ones is refused
 
 
 class GraphCache:
@@ -31,6 +32,7 @@ class GraphCache:
         self._processes: dict[int, ProcessRecord] = {}
         self._changed = threading.Condition()
         self.generation = 0  # increments on every change
+        self.refused = 0  # announcements of new processes refused while the table was full
 
     # --- updates -----------------------------------------------------------------------------
 
@@ -38,6 +40,9 @@ class GraphCache:
         """Store a process's announcement; return whether the graph changed."""
         with self._changed:
             old = self._processes.get(record.sender)
+            if old is None and len(self._processes) >= MAX_PROCESSES:
+                self.refused += 1  # known processes keep their place; leases free room
+                return False
             self._processes[record.sender] = record
             changed = old is None or old.nodes != record.nodes
             if changed:

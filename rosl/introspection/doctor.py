@@ -1,9 +1,11 @@
 """``rosl doctor``: setup checks with one line each, ROS 2's summary line, and ``--report``.
 
 Checks, in order: ``domain`` (the id and where it came from), ``network`` (our own graph query
-comes back over multicast), ``package`` (search path: broken package.xml fails, shadowing
-warns), ``interface`` (every .msg/.srv parses and its references resolve), ``node`` (no two
-nodes share a name) and ``topic`` (one type per topic; publishers without subscribers warn).
+comes back over multicast), ``security`` (whether datagrams are signed, with which key, and
+what traffic of other keys or unsigned senders was dropped while listening), ``package``
+(search path: broken package.xml fails, shadowing warns), ``interface`` (every .msg/.srv
+parses and its references resolve), ``node`` (no two nodes share a name) and ``topic`` (one
+type per topic; publishers without subscribers warn).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import os
 import platform
 import socket
 import sys
+import time
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -26,6 +29,7 @@ if TYPE_CHECKING:
     from rosl.introspection.session import Session
 
 QUERY_TIMEOUT = 2.0
+LISTEN_S = 1.2  # longer than a discovery period: every process announced itself once
 QUIET_TOPICS = ("/parameter_events", "/rosout")  # never warned about, as in ros2doctor
 MAX_DETAILS = 5
 
@@ -62,7 +66,7 @@ class Diagnosis:
 def diagnose(session: Session, domain: int | None = None) -> Diagnosis:
     """Run every check (none raises: a broken step becomes a failed check)."""
     result = Diagnosis()
-    for check in (_domain, _network, _packages, _interfaces, _nodes, _topics):
+    for check in (_domain, _network, _security, _packages, _interfaces, _nodes, _topics):
         result.checks.append(check(result, session, domain))
     return result
 
@@ -115,6 +119,41 @@ def _network(result: Diagnosis, session: Session, domain: int | None) -> CheckRe
     route = f"{where.group(0)}:{where.port} via {where.interface} (TTL {where.ttl})"
     summary = f"multicast works on {route}; {processes} process(es) answered"
     return CheckResult("network", True, summary, warnings)
+
+
+def _security(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
+    """Authentication on or off, and what the discovery channel dropped while we listened."""
+    del domain
+    if result.graph is None:
+        return CheckResult("security", True, "not checked: the bus is not usable", skipped=True)
+    participant = session.participant
+    auth = participant.transport.auth
+    if auth is None:
+        return CheckResult(
+            "security",
+            True,
+            "authentication is off (ROSL_KEY=none)",
+            ("any process on this host can publish, call services and set parameters",),
+        )
+    remaining = participant.discovery.started + LISTEN_S - time.monotonic()
+    if remaining > 0:
+        time.sleep(remaining)
+    dropped = participant.discovery.dropped()
+    strangers = dropped["forged"] + dropped["unsigned"]
+    summary = f"datagrams are signed with the key from {auth.source} ({auth.fingerprint})"
+    warnings: list[str] = []
+    if strangers:
+        warnings.append(
+            f"dropped {strangers} datagram(s) of processes under another key or none "
+            f"({dropped['forged']} with another key, {dropped['unsigned']} unsigned): another "
+            "user's rosl, or ROSL_KEY differs; share a key with ROSL_KEY_FILE to hear them"
+        )
+    if dropped["stale"] or dropped["duplicates"]:
+        warnings.append(
+            f"dropped {dropped['stale']} stale and {dropped['duplicates']} repeated "
+            "datagram(s): replayed traffic, or clocks more than 30 s apart"
+        )
+    return CheckResult("security", True, summary, tuple(warnings))
 
 
 def _packages(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:

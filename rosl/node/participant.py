@@ -71,6 +71,7 @@ class Participant:
         self.discovery = Discovery(self.transport, self.sender, self._describe)
         self.discovery.handlers["replay"] = self._on_replay_request
         self.discovery.handlers["typedef_request"] = self._on_typedef_request
+        self.discovery.on_gone.append(self.reader.forget)  # its streams' state is retired
         self.closed = False
         self.discovery.start()
 

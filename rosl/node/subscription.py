@@ -28,7 +28,7 @@ from rosl.node.qos import HistoryPolicy
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from rosl.bus.wire import Delivery, StreamStats
+    from rosl.bus.wire import Delivery
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
@@ -38,6 +38,7 @@ _REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster t
 _LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
 KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
+MAX_PEERS = 4096  # publishers a subscription remembers what the graph said of
 
 
 def queue_depth(qos: QoSProfile) -> int:
@@ -65,7 +66,6 @@ class _Peer:
 
     agrees: bool | None  # same definition of the type; None while discovery has not told
     generation: int  # the graph's generation when that was decided
-    stats: StreamStats | None  # its stream's sequence bookkeeping (loss)
 
 
 class Subscription(Queued):
@@ -166,6 +166,8 @@ class Subscription(Queued):
         key = (delivery.sender, delivery.endpoint)
         peer = self._peers.get(key)
         if peer is None or (peer.agrees is None and peer.generation != self._graph.generation):
+            if len(self._peers) >= MAX_PEERS:
+                self._peers.clear()  # a cache of the graph: strangers' ids must not grow it
             peer = self._peers[key] = self._meet(delivery)
         if peer.agrees is False:
             self.mismatched += 1
@@ -173,8 +175,7 @@ class Subscription(Queued):
         if delivery.kind == _DATA:
             if self.qos_profile.keeps_history:
                 self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
-            stats = peer.stats or self._streams.get(key)
-            peer.stats = stats
+            stats = self._streams.get(key)
             if stats is not None and stats.lost and delivery.received >= self._lost_told_at:
                 self._tell_loss(delivery)
         if self.raw:
@@ -201,7 +202,7 @@ class Subscription(Queued):
 
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1
-        if delivery.sender in self._warned:
+        if delivery.sender in self._warned or len(self._warned) >= MAX_PEERS:
             return
         self._warned.add(delivery.sender)
         found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)
@@ -230,10 +231,9 @@ class Subscription(Queued):
         announced yet is delivered, and asked about again when the graph changes.
         """
         generation = self._graph.generation
-        stats = self._streams.get((delivery.sender, delivery.endpoint))
         found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)
         if found is None:
-            return _Peer(None, generation, stats)
+            return _Peer(None, generation)
         node, endpoint = found
         agrees = not endpoint.digest or not self.digest or endpoint.digest == self.digest
         if not agrees:
@@ -242,7 +242,7 @@ class Subscription(Queued):
                 f".msg files define it, but {node.fqn} publishes another definition of it "
                 "(one of the two .msg files changed); dropped without decoding"
             )
-        return _Peer(agrees, generation, stats)
+        return _Peer(agrees, generation)
 
     @property
     def lost(self) -> int:

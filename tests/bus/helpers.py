@@ -221,3 +221,31 @@ rosl.shutdown()
 def good_count(lines: list[str]) -> int:
     """The listener's latest count of valid messages (it prints one line every 10)."""
     return max((int(x.split()[1]) for x in lines if x.startswith("good ")), default=0)
+
+
+def signed(datagram: bytes, domain: int) -> bytes:
+    """``datagram`` as a process holding the domain's key sends it: SIGNED set, MAC appended.
+
+    A datagram that already carries a MAC loses it first, so mutated real datagrams are
+    re-signed (what a fuzzer with the key sends, reaching every parser behind the MAC check).
+    """
+    from rosl.bus import auth
+    from rosl.bus.header import HEADER_SIZE, Flags
+
+    key = auth.load(domain)
+    assert key is not None, "the tests run with the default per-user key"
+    body = bytearray(datagram)
+    if len(body) >= HEADER_SIZE:
+        if body[4] & Flags.SIGNED:
+            del body[-auth.MAC_SIZE :]
+        body[4] |= Flags.SIGNED
+    return bytes(body) + key.mac(bytes(body))
+
+
+def unsigned_payload(datagram: bytes) -> bytes:
+    """The payload of a real (signed) datagram: between the header and the MAC."""
+    from rosl.bus.auth import MAC_SIZE
+    from rosl.bus.header import HEADER_SIZE, Flags
+
+    end = len(datagram) - (MAC_SIZE if datagram[4] & Flags.SIGNED else 0)
+    return datagram[HEADER_SIZE:end]

@@ -7,11 +7,12 @@ import random
 
 import pytest
 
+from rosl.bus.auth import MAC_SIZE
 from rosl.bus.fragment import LAZY_ABOVE, MAX_AGE_NS, MAX_MESSAGE_SIZE, Reassembler, split
 from rosl.bus.header import HEADER_SIZE, MAGIC, VERSION, Header, Kind
 
 CHUNK = 100  # small chunks keep the unit tests readable
-REAL_CHUNK = 65000 - HEADER_SIZE  # what a loopback Writer uses
+REAL_CHUNK = 65000 - HEADER_SIZE - MAC_SIZE  # what a loopback Writer (signing) uses
 
 
 def payload_of(size: int, seed: int = 0) -> bytes:
@@ -323,7 +324,7 @@ def test_offset_beyond_the_total_is_malformed() -> None:
 
 def test_malformed_fragments_never_raise() -> None:
     rng = random.Random(1234)
-    r = Reassembler(max_pending=4 * 1024 * 1024)
+    r = Reassembler(budget=4 * 1024 * 1024)
     for _ in range(3000):
         count = rng.choice([1, 2, 3, rng.randrange(1, 2**16)])
         total = rng.choice(
@@ -353,23 +354,24 @@ def test_malformed_fragments_never_raise() -> None:
 def test_pending_bytes_stay_under_the_cap() -> None:
     total = 1000
     cap = 10 * total
-    r = Reassembler(max_pending=cap)
+    r = Reassembler(budget=cap)
     for sender in range(200):
         frags = fragments(payload_of(total, seed=sender), sender=sender)
         feed(r, frags[:1])  # a partial per sender, never completed
         assert r.pending * total <= cap
     assert r.pending == cap // total
-    assert r.incomplete == 200 - cap // total
+    assert r.held <= cap
+    assert r.evicted == 200 - cap // total
 
 
 def test_cap_evicts_the_oldest_partial_first() -> None:
     total = 1000
-    r = Reassembler(max_pending=3 * total)
+    r = Reassembler(budget=3 * total)
     payloads = {s: payload_of(total, seed=s) for s in range(5)}
     frags = {s: fragments(payloads[s], sender=s) for s in payloads}
     for s in payloads:
         feed(r, frags[s][:1])
-    assert (r.pending, r.incomplete) == (3, 2)
+    assert (r.pending, r.evicted) == (3, 2)
     # senders 0 and 1 were evicted; 2, 3, 4 can still complete
     for s in (2, 3, 4):
         assert feed(r, frags[s][1:]) == [payloads[s]]
@@ -378,8 +380,8 @@ def test_cap_evicts_the_oldest_partial_first() -> None:
 
 def test_completed_messages_free_their_share_of_the_cap() -> None:
     total = 1000
-    r = Reassembler(max_pending=2 * total)
+    r = Reassembler(budget=2 * total)
     for seq in range(50):
         payload = payload_of(total, seed=seq)
         assert feed(r, fragments(payload, sender=seq)) == [payload]
-    assert (r.pending, r.incomplete) == (0, 0)
+    assert (r.pending, r.incomplete, r.evicted, r.held) == (0, 0, 0, 0)

@@ -37,7 +37,7 @@ def test_sizes_are_the_documented_ones() -> None:
     assert HEADER_SIZE == 48
     assert ADDRESS_SIZE == 16
     assert MAGIC == b"RL"
-    assert VERSION == 1
+    assert VERSION == 2
 
 
 def test_pack_unpack_round_trips_every_field() -> None:
@@ -47,7 +47,7 @@ def test_pack_unpack_round_trips_every_field() -> None:
     got = unpack(data)
     assert got == Header(
         magic=b"RL",
-        version=1,
+        version=2,
         kind=Kind.RESPONSE,
         flags=Flags.ADDRESSED,
         count=7,
@@ -140,8 +140,9 @@ def _raw(**override: object) -> bytes:
         pytest.param(b"R", id="one-byte"),
         pytest.param(_raw()[: HEADER_SIZE - 1], id="short-by-one"),
         pytest.param(_raw(version=0), id="version-0"),
-        pytest.param(_raw(version=2), id="future-version"),
+        pytest.param(_raw(version=3), id="future-version"),
         pytest.param(_raw(version=255), id="version-255"),
+        pytest.param(_raw(version=1), id="old-version"),
         pytest.param(_raw(count=0), id="count-0"),
         pytest.param(_raw(count=0, index=0), id="count-0-index-0"),
         pytest.param(_raw(count=1, index=1), id="index-equals-count"),

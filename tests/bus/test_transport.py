@@ -47,8 +47,13 @@ def collect(receiver: Receiver, count: int, channel: int | None = None) -> list[
     return got
 
 
+def endpoint_of(topic: str) -> int:
+    """One endpoint number per topic, as a process numbers its endpoints."""
+    return 7 + sum(topic.encode())
+
+
 def writer(transport: Transport, topic: str = "/seam", sender: int = 0xABC) -> Writer:
-    return Writer(transport, sender, 7, topic, "std_msgs/msg/String")
+    return Writer(transport, sender, endpoint_of(topic), topic, "std_msgs/msg/String")
 
 
 def test_a_joined_receiver_gets_whole_deliveries_with_their_sender_sequence_and_stamps(
@@ -64,7 +69,9 @@ def test_a_joined_receiver_gets_whole_deliveries_with_their_sender_sequence_and_
     got = collect(receiver, 5)
     assert [bytes(d.payload) for d in got] == [b"message %d" % i for i in range(5)]
     assert [d.seq for d in got] == [1, 2, 3, 4, 5]
-    assert {(d.sender, d.endpoint, d.topic) for d in got} == {(0xABC, 7, topic_hash("/seam"))}
+    assert {(d.sender, d.endpoint, d.topic) for d in got} == {
+        (0xABC, endpoint_of("/seam"), topic_hash("/seam"))
+    }
     assert all(before <= d.stamp <= d.received for d in got)
     assert receiver.reader.lost() == 0
 

@@ -13,8 +13,19 @@ from typing import TYPE_CHECKING
 import pytest
 
 from rosl.bus import multicast
+from rosl.bus.auth import MAC_SIZE
 from rosl.bus.errors import BusError
-from rosl.bus.header import ADDRESS, HEADER, HEADER_SIZE, MAGIC, Flags, Kind, topic_hash, type_hash
+from rosl.bus.header import (
+    ADDRESS,
+    HEADER,
+    HEADER_SIZE,
+    MAGIC,
+    VERSION,
+    Flags,
+    Kind,
+    topic_hash,
+    type_hash,
+)
 from rosl.bus.multicast import (
     CHANNELS,
     Addressing,
@@ -38,7 +49,7 @@ TOPIC = "/bus_test/blob"
 TYPE = "test_msgs/msg/Blob"
 SENDER = 0x1234_5678_9ABC_DEF1
 ENDPOINT = 7
-CHUNK = 65000 - HEADER_SIZE
+CHUNK = 65000 - HEADER_SIZE - MAC_SIZE  # payload bytes of one (signed) datagram
 
 
 def same_channel_name(name: str) -> str:
@@ -111,10 +122,11 @@ def test_messages_arrive_byte_identical_with_their_header_fields(bus: Bus, size:
 
 
 def test_explicit_stamp_and_seq_are_carried(bus: Bus) -> None:
-    bus.writer.send(b"x", seq=41, stamp=123_456_789)
-    bus.writer.send(payload_of(CHUNK * 2), seq=42, stamp=-5)
+    now = time.time_ns()  # a stream's first stamp must be near the receiver's clock
+    bus.writer.send(b"x", seq=41, stamp=now + 7)
+    bus.writer.send(payload_of(CHUNK * 2), seq=42, stamp=now - 5)
     got = bus.collector.wait_count(2)
-    assert [(d.seq, d.stamp) for d in got] == [(41, 123_456_789), (42, -5)]
+    assert [(d.seq, d.stamp) for d in got] == [(41, now + 7), (42, now - 5)]
 
 
 def test_many_messages_in_a_row_keep_their_order_and_content(bus: Bus) -> None:
@@ -266,13 +278,13 @@ def test_a_reader_only_hears_the_channels_it_joined(bus: Bus) -> None:
 
 def test_foreign_datagrams_are_counted_not_delivered(bus: Bus) -> None:
     channel = bus.writer.channel
-    good = HEADER.pack(MAGIC, 1, 1, 0, 1, SENDER, 1, bus.writer.topic, 1, 0, 1, 0, 0)
+    good = HEADER.pack(MAGIC, VERSION, 1, 0, 1, SENDER, 1, bus.writer.topic, 1, 0, 1, 0, 0)
     for junk in (
         b"",
         b"RL",
         b"hello world, not rosl at all" * 3,
         b"XX" + good[2:],
-        good[:2] + b"\x02" + good[3:],  # version 2
+        good[:2] + b"\x01" + good[3:],  # version 1 (before the MAC trailer)
         good[:6] + b"\x00\x00" + good[8:],  # count 0
     ):
         bus.tx.send(channel, [junk])
@@ -283,7 +295,9 @@ def test_foreign_datagrams_are_counted_not_delivered(bus: Bus) -> None:
 
 
 def test_single_datagram_with_a_lying_total_is_malformed(bus: Bus) -> None:
-    head = HEADER.pack(MAGIC, 1, 1, 0, 1, SENDER, 1, bus.writer.topic, 1, 0, 1, 99, 0)
+    head = HEADER.pack(
+        MAGIC, VERSION, 1, 0, 1, SENDER, 1, bus.writer.topic, 1, 0, 1, 99, time.time_ns()
+    )
     bus.tx.send(bus.writer.channel, [head + b"short"])
     bus.writer.send(b"marker")
     got = bus.collector.wait_count(1)
@@ -323,13 +337,14 @@ def test_replay_keeps_the_original_seq_and_address(bus: Bus) -> None:
 
 def test_addressed_flag_on_a_too_short_payload_is_malformed(bus: Bus) -> None:
     head = HEADER.pack(
-        MAGIC, 1, Kind.RESPONSE, Flags.ADDRESSED, 1, SENDER, 1, bus.writer.topic, 1, 0, 1, 4, 0
-    )
+        MAGIC, VERSION, Kind.RESPONSE, Flags.ADDRESSED, 1, SENDER, 1, bus.writer.topic, 1, 0,
+        1, 4, time.time_ns(),
+    )  # fmt: skip
     bus.tx.send(bus.writer.channel, [head + b"tiny"])
     full = ADDRESS.pack(1, 2, 3)
     head = HEADER.pack(
-        MAGIC, 1, Kind.RESPONSE, Flags.ADDRESSED, 1, SENDER, 2, bus.writer.topic, 1, 0, 1,
-        len(full), 0,
+        MAGIC, VERSION, Kind.RESPONSE, Flags.ADDRESSED, 1, SENDER, 2, bus.writer.topic, 1, 0,
+        1, len(full), time.time_ns(),
     )  # fmt: skip
     bus.tx.send(bus.writer.channel, [head + full])  # an address and an empty payload: fine
     got = bus.collector.wait_count(1)
@@ -347,7 +362,10 @@ def test_a_stale_partial_message_is_dropped_after_max_age(bus: Bus) -> None:
     (no newer message from that stream). The Reader must expire it.
     """
     total = 2 * CHUNK
-    head = HEADER.pack(MAGIC, 1, Kind.DATA, 0, 2, 0xDEAD, 1, bus.writer.topic, 1, 0, 1, total, 0)
+    head = HEADER.pack(
+        MAGIC, VERSION, Kind.DATA, 0, 2, 0xDEAD, 1, bus.writer.topic, 1, 0, 1, total,
+        time.time_ns(),
+    )  # fmt: skip
     bus.tx.send(bus.writer.channel, [head + bytes(CHUNK)])  # fragment 0 of 2; 1 never comes
     bus.writer.send(b"first")
     assert len(bus.collector.wait_count(1)) == 1

@@ -56,10 +56,10 @@ def test_doctor_passes_on_a_clean_domain(processes, domain_id: int) -> None:
     result = run(processes)
     assert result.code == 0, result.out + result.err
     assert "Traceback" not in result.err
-    for name in ("domain", "network", "package", "interface", "node", "topic"):
+    for name in ("domain", "network", "security", "package", "interface", "node", "topic"):
         assert check_line(result, name).startswith("[ OK ]")
     assert f"domain {domain_id} (from ROSL_DOMAIN_ID)" in check_line(result, "domain")
-    assert result.out.endswith("\nAll 6 checks passed\n\n")
+    assert result.out.endswith("\nAll 7 checks passed\n\n")
 
 
 def test_a_publisher_without_subscriber_is_a_warning_not_a_failure(processes) -> None:
@@ -69,7 +69,7 @@ def test_a_publisher_without_subscriber_is_a_warning_not_a_failure(processes) ->
     assert check_line(result, "topic").startswith("[WARN]")
     assert "UserWarning: Publisher without subscriber detected on /cmd_vel." in result.out
     assert "/rosout" not in result.out  # every node's /rosout is not worth a warning
-    assert "All 6 checks passed" in result.out
+    assert "All 7 checks passed" in result.out
 
 
 def test_two_nodes_with_the_same_name_fail_the_node_check(processes) -> None:
@@ -79,7 +79,7 @@ def test_two_nodes_with_the_same_name_fail_the_node_check(processes) -> None:
     assert result.code == 1, result.out
     assert check_line(result, "node").startswith("[FAIL]")
     assert "2 nodes are named /twin" in result.out
-    assert result.out.endswith("\n1/6 check(s) failed\n\nFailed modules: node\n")
+    assert result.out.endswith("\n1/7 check(s) failed\n\nFailed modules: node\n")
 
 
 def test_a_topic_with_two_types_fails_the_topic_check(processes) -> None:
@@ -155,7 +155,7 @@ def test_report_prints_ros2_doctor_sections_with_padded_names(processes, domain_
     topics = out.split("TOPIC LIST\n")[1].split("\n\n")[0].splitlines()
     at = topics.index("topic               : /chatter")
     assert topics[at + 1 : at + 3] == ["publisher count     : 1", "subscriber count    : 0"]
-    assert "All 6 checks passed" in out
+    assert "All 7 checks passed" in out
 
 
 READING = """
@@ -194,3 +194,35 @@ def test_one_type_read_from_two_different_msg_files_fails_the_topic_check(
         "(/new_listener; /old_talker)"
         in result.out
     ), result.out
+
+
+def test_doctor_says_which_key_signs_and_reports_strangers_in_one_line(
+    processes, domain_id: int
+) -> None:
+    env = {"ROSL_KEY": "doctor's team"}
+    stranger = processes.python(NODES, "stranger", env={"ROSL_KEY": "another user"})
+    assert stranger.stdout is not None
+    assert stranger.stdout.readline().strip() == "ready"
+    result = run(processes, env=env)
+    line = check_line(result, "security")
+    assert line.startswith("[WARN] security: datagrams are signed with the key from ROSL_KEY")
+    warnings = [x for x in result.out.splitlines() if "another key" in x]
+    assert len(warnings) == 1, result.out
+    assert "dropped" in warnings[0]
+    assert "/stranger" not in result.out
+    assert result.code == 0  # a warning, not a failure
+
+
+def test_doctor_says_when_authentication_is_off(processes, domain_id: int) -> None:
+    result = run(processes, env={"ROSL_KEY": "none"})
+    line = check_line(result, "security")
+    assert line == "[WARN] security: authentication is off (ROSL_KEY=none)"
+    assert "any process on this host can publish" in result.out
+
+
+def test_doctor_passes_security_when_only_our_key_is_heard(processes, domain_id: int) -> None:
+    start(processes, "friend")
+    result = run(processes)
+    line = check_line(result, "security")
+    assert line.startswith("[ OK ] security: datagrams are signed with the key from ")
+    assert "key" in line

@@ -1,0 +1,281 @@
+"""Sequence windows: nothing delivered twice, loss counted exactly, no datagram poisons a stream,
+and the state strangers can make a reader keep is bounded."""
+
+from __future__ import annotations
+
+import os
+import random
+import threading
+import time
+from typing import TYPE_CHECKING
+
+import pytest
+
+from rosl.bus import auth, wire
+from rosl.bus.header import HEADER, MAGIC, VERSION, Flags, Kind, topic_hash, type_hash
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.transport import channel_of
+from rosl.bus.wire import Reader
+from tests.bus.helpers import Collector
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+TOPIC = "/window_test"
+TOPIC_HASH = topic_hash(TOPIC)
+TYPE_HASH = type_hash("std_msgs/msg/String")
+CHANNEL = channel_of(TOPIC_HASH)
+SENDER = 0x5E55_1011
+KEY = b"window test key"
+
+
+class Wire:
+    """Hand-made signed datagrams onto a real socket, and a keyed reader collecting them."""
+
+    def __init__(self, domain: int) -> None:
+        self.auth = auth.Auth(KEY, domain, "test")
+        self.tx = MulticastTransport(Addressing(domain), None)
+        self.rx = MulticastTransport(Addressing(domain), None)
+        self.reader = Reader(self.auth)
+        self.reader.wanted.add(TOPIC_HASH)
+        self.logged: list[str] = []
+        self.reader.log = self.logged.append
+        self.collector = Collector(self.reader, self.rx.open(CHANNEL))
+
+    def datagram(
+        self,
+        seq: int,
+        payload: bytes = b"m",
+        *,
+        sender: int = SENDER,
+        endpoint: int = 1,
+        kind: int = Kind.DATA,
+        stamp: int | None = None,
+        count: int = 1,
+        index: int = 0,
+        total: int | None = None,
+    ) -> bytes:
+        head = HEADER.pack(
+            MAGIC, VERSION, kind, Flags.SIGNED, count, sender, seq, TOPIC_HASH, TYPE_HASH,
+            index, endpoint, len(payload) if total is None else total,
+            time.time_ns() if stamp is None else stamp,
+        )  # fmt: skip
+        return head + payload + self.auth.mac(head + payload)
+
+    def send(self, *datagrams: bytes) -> None:
+        for datagram in datagrams:
+            self.tx.send(CHANNEL, [datagram])
+
+    def marker(self, seq: int, sender: int = SENDER) -> None:
+        """Send a last datagram and wait for it: everything before it was read."""
+        self.send(self.datagram(seq, b"marker", sender=sender))
+        assert self.collector.wait_for(
+            lambda got: any(bytes(d.payload) == b"marker" and d.seq == seq for d in got), 10.0
+        ), "the marker never arrived"
+
+    def seqs(self) -> list[int]:
+        return [d.seq for d in self.collector.snapshot() if bytes(d.payload) != b"marker"]
+
+    def close(self) -> None:
+        self.collector.stop()
+        self.tx.close()
+        self.rx.close()
+
+
+@pytest.fixture
+def bus(domain_id: int) -> Iterator[Wire]:
+    w = Wire(domain_id)
+    try:
+        yield w
+    finally:
+        w.close()
+
+
+def test_a_resent_datagram_is_delivered_once(bus: Wire) -> None:
+    bus.send(bus.datagram(1))
+    for _ in range(30):
+        bus.send(bus.datagram(2, b"again"))  # the same message, 30 times
+    bus.marker(3)
+    assert bus.seqs() == [1, 2]
+    assert bus.reader.duplicates == 29  # the first of the 30 was new
+    assert bus.reader.lost() == 0
+
+
+def test_a_replayed_old_message_is_not_delivered_again(bus: Wire) -> None:
+    old = [bus.datagram(seq) for seq in range(1, 201)]
+    bus.send(*old[:100])
+    bus.marker(201)
+    bus.send(*old[:100])  # replayed, inside the window
+    bus.send(bus.datagram(5000))  # the stream moves on by more than the duplicate window
+    bus.send(old[99])  # seq 100 again, now far behind the window: stale
+    bus.marker(5001)
+    assert bus.seqs() == [*range(1, 101), 5000]
+    assert bus.reader.duplicates == 100
+    assert bus.reader.stale == 1
+
+
+def test_gaps_are_counted_exactly_and_a_late_message_takes_its_gap_back(bus: Wire) -> None:
+    for seq in [*range(1, 11), *range(16, 21)]:  # 11..15 missing
+        bus.send(bus.datagram(seq))
+    bus.marker(21)
+    assert bus.reader.lost() == 5
+    bus.send(bus.datagram(13))  # one of them arrives late
+    bus.marker(22)
+    assert bus.reader.lost() == 4
+    assert 13 in bus.seqs()
+
+
+def test_one_forged_jump_neither_poisons_the_loss_count_nor_stops_the_stream(bus: Wire) -> None:
+    for seq in range(1, 11):
+        bus.send(bus.datagram(seq))
+    bus.marker(11)
+    bus.send(bus.datagram(11 + 0x7FFFFFF0))  # signed by a key holder, sequence far ahead
+    for seq in range(12, 20):  # the real publisher goes on
+        bus.send(bus.datagram(seq))
+    bus.marker(20)
+    assert bus.reader.lost() == 0
+    # the forged message itself is delivered (a key holder can send one), nothing is lost
+    assert bus.seqs() == [*range(1, 11), 11 + 0x7FFFFFF0, *range(12, 20)]
+    for seq in (22, 23):  # a real gap after the jump is still counted
+        bus.send(bus.datagram(seq))
+    bus.marker(24)
+    assert bus.reader.lost() == 1
+    assert len(bus.logged) == 1  # once per stream, however often it jumps
+    assert "jumped" in bus.logged[0]
+
+
+def test_an_old_datagram_opening_a_stream_is_stale(bus: Wire) -> None:
+    old = time.time_ns() - wire.FRESH_NS - 1_000_000_000
+    bus.send(bus.datagram(1, sender=0x01D, stamp=old))
+    bus.send(bus.datagram(1, sender=0x0FF, stamp=time.time_ns() + 2 * wire.FRESH_NS))
+    bus.marker(1)
+    assert bus.seqs() == []
+    assert bus.reader.stale == 2
+
+
+def test_a_forgotten_stream_stays_protected_and_resumes_its_loss_count(bus: Wire) -> None:
+    captured = [bus.datagram(seq) for seq in range(1, 6)]
+    bus.send(*captured)
+    bus.marker(6)
+    bus.reader.forget(SENDER)  # the process said goodbye
+    bus.reader._next_housekeeping = 0  # the next look retires it now
+    bus.send(bus.datagram(1, sender=0x0DD))  # a look at the socket
+    assert bus.collector.wait_for(lambda _: (SENDER, 1) not in bus.reader.streams, 10.0)
+    bus.send(*captured)  # replayed after the state was retired
+    bus.send(bus.datagram(9))  # the stream's next message (7 and 8 lost)
+    bus.marker(10)
+    # 1-5, the look (seq 1 of another sender) and 9: the replay was not delivered
+    assert bus.seqs() == [1, 2, 3, 4, 5, 1, 9]
+    assert bus.reader.lost() == 2
+    assert bus.reader.stale == 5
+
+
+def test_service_streams_are_told_apart_by_target(bus: Wire) -> None:
+    # a server's responses to two clients of one process carry its one sequence counter
+    from rosl.bus.header import ADDRESS
+
+    for seq, target in ((1, 10), (2, 11), (3, 10)):
+        body = ADDRESS.pack(0xC11E, target, seq) + b"answer"
+        head = HEADER.pack(
+            MAGIC, VERSION, Kind.RESPONSE, Flags.SIGNED | Flags.ADDRESSED, 1, SENDER, seq,
+            TOPIC_HASH, TYPE_HASH, 0, 4, len(body), time.time_ns(),
+        )  # fmt: skip
+        datagram = head + body + bus.auth.mac(head + body)
+        bus.send(datagram, datagram)  # each twice
+    bus.marker(1)
+    got = [(d.seq, d.address) for d in bus.collector.snapshot() if d.kind == Kind.RESPONSE]
+    assert got == [(1, (0xC11E, 10, 1)), (2, (0xC11E, 11, 2)), (3, (0xC11E, 10, 3))]
+    assert bus.reader.duplicates == 3
+
+
+# --- bounded state ------------------------------------------------------------------------------
+
+
+def test_random_sender_ids_cannot_grow_the_stream_table(
+    bus: Wire, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(wire, "MAX_STREAMS", 500)
+    monkeypatch.setattr(wire, "MAX_RETIRED", 700)
+    rng = random.Random(7)
+    for number in range(3000):
+        bus.send(bus.datagram(rng.getrandbits(32), sender=rng.getrandbits(64)))
+        if number % 200 == 199:
+            time.sleep(0.02)  # let the reader keep up (loss is fine: the bound is the point)
+    bus.marker(1)
+    assert len(bus.reader.streams) <= 500
+    assert len(bus.reader._retired) <= 700
+    assert bus.reader.retired > 0
+    assert bus.reader.received() == len(bus.collector.snapshot())  # retired counts folded in
+
+
+def test_fragments_from_random_senders_stay_inside_the_reassembly_budget(bus: Wire) -> None:
+    bus.reader.reassembler.budget = 4 * 1024 * 1024
+    rng = random.Random(11)
+    chunk = os.urandom(60_000)
+    peak = 0
+    for number in range(400):  # fragment 0 of a 3-fragment message, from 400 senders
+        bus.send(bus.datagram(1, chunk, sender=rng.getrandbits(64), count=3, total=180_000))
+        if number % 50 == 49:
+            time.sleep(0.02)
+            peak = max(peak, bus.reader.reassembler.held)
+    bus.marker(1)
+    peak = max(peak, bus.reader.reassembler.held)
+    assert peak <= 4 * 1024 * 1024
+    assert bus.reader.reassembler.evicted > 0
+
+
+def test_lazily_mapped_messages_are_charged_as_they_fill() -> None:
+    from rosl.bus.fragment import Reassembler
+    from rosl.bus.header import Header
+
+    r = Reassembler(budget=8 * 1024 * 1024)
+    total = 64 * 1024 * 1024 // 16  # 4 MiB: a lazily mapped buffer
+    chunk = 64_000
+    count = -(-total // chunk)
+
+    for sender in range(100):  # 100 messages started: only what arrived is charged
+        header = Header(MAGIC, VERSION, 1, 0, count, sender, 1, 1, 1, 0, 1, total, 0)
+        assert r.add(header, memoryview(bytes(chunk)), 0) is None
+    assert r.held <= 8 * 1024 * 1024
+    assert r.pending == 100
+    assert r.evicted == 0
+    too_big = Reassembler(budget=1024 * 1024)
+    too_big.add(
+        Header(MAGIC, VERSION, 1, 0, count, 1, 1, 1, 1, 0, 1, total, 0),
+        memoryview(bytes(chunk)),
+        0,
+    )
+    assert (too_big.oversize, too_big.pending) == (1, 0)
+
+
+def test_counting_loss_while_streams_come_and_go_never_fails() -> None:
+    """The discovery thread counts loss (announcing) while the polling thread adds streams."""
+    reader = Reader(None)
+    reader.want_all = True
+    errors: list[BaseException] = []
+    stop = threading.Event()
+
+    def count() -> None:
+        try:
+            while not stop.is_set():
+                reader.lost(TOPIC_HASH)
+                reader.received()
+        except BaseException as err:
+            errors.append(err)
+
+    counters = [threading.Thread(target=count) for _ in range(2)]
+    for thread in counters:
+        thread.start()
+    now = time.time_ns()
+    rng = random.Random(3)
+    try:
+        for sender in range(60_000):
+            stats = wire.StreamStats(TOPIC_HASH, last_received=now)
+            reader.streams[(rng.getrandbits(64), sender & 0xFFFF)] = stats
+            if sender % 5000 == 4999:
+                reader._housekeeping(now + wire.SILENT_NS + 1)  # retire them all
+    finally:
+        stop.set()
+        for thread in counters:
+            thread.join(10)
+    assert errors == []
