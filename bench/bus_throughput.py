@@ -196,6 +196,8 @@ def main() -> None:
     print(f"\n{'mac cost':>9} {'signed/s':>10} {'unsigned/s':>10} {'ratio':>6}")
     for kind, size in (("bus", 64), ("bus", 1024), ("bus", 60000), ("coalesced", 64)):
         count = max(200, min(args.count, int(4e9 / max(size, 1) / 10)))
+        if kind == "coalesced":
+            count = args.count * 4  # as above: enough batches to time
         signed, unsigned = [], []
         for _ in range(args.runs):  # interleaved: both see the same machine
             with key(None):

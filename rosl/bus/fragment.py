@@ -4,11 +4,12 @@ Every fragment but the last carries exactly ``chunk`` bytes, so a fragment's off
 ``index * len(payload)`` (the last one's is ``total - len(payload)``): fragments may arrive in
 any order. Incomplete messages are dropped after ``max_age_ns`` or when a newer message from
 the same endpoint starts, and counted. Memory is bounded by one budget for all partial
-messages of a reader (``ROSL_REASSEMBLY_MB``, 64 MiB by default), counted as the memory the
-buffers really hold: small buffers whole, big ones (lazily mapped) as their fragments arrive.
-When a fragment would pass the budget the oldest partial messages are evicted (counted); a
-message bigger than the whole budget is refused with one warning saying how to raise it. So a
-flood of fragments from made-up senders costs at most the budget, and only for a second.
+messages of a reader (``ROSL_REASSEMBLY_MB``, 48 MiB by default), counted as the memory they
+really hold: small buffers whole, big ones (lazily mapped) by the pages their fragments
+touch, plus :data:`PARTIAL_OVERHEAD` for each one's bookkeeping. When a fragment would pass
+the budget the oldest partial messages are evicted (counted); a message bigger than the whole
+budget is refused with one warning saying how to raise it. So a flood of fragments from
+made-up senders costs at most the budget, and only for a second.
 """
 
 from __future__ import annotations
@@ -26,7 +27,9 @@ if TYPE_CHECKING:
     from rosl.bus.header import Header
 
 MAX_MESSAGE_SIZE = 256 * 1024 * 1024  # bytes; larger claims are foreign or broken
-BUDGET_MB = 64  # all partial messages of one reader together (ROSL_REASSEMBLY_MB)
+BUDGET_MB = 48  # all partial messages of one reader together (ROSL_REASSEMBLY_MB)
+PARTIAL_OVERHEAD = 1024  # bytes charged per partial message for its bookkeeping
+PAGE = mmap.PAGESIZE
 MAX_AGE_NS = 1_000_000_000
 
 
@@ -100,10 +103,14 @@ class Reassembler:
         key = (header.sender, header.endpoint, header.kind, header.seq)
         partial = self._partial.get(key)
         if partial is None:
-            if total > self.budget:
+            if total + PARTIAL_OVERHEAD > self.budget:
                 self._too_big(total)
                 return None
-            partial = self._start(key, total, count, now_ns)
+            try:
+                partial = self._start(key, total, count, now_ns)
+            except (OSError, MemoryError):  # the OS refused the buffer (e.g. too many maps)
+                self.evicted += 1
+                return None
         elif partial.count != count or len(partial.buffer) != total:
             self.malformed += 1
             return None
@@ -114,9 +121,10 @@ class Reassembler:
             self.malformed += 1
             return None
         if isinstance(partial.buffer, mmap.mmap):  # lazily mapped: memory grows as it fills
-            self._make_room(size, key)
-            partial.held += size
-            self._held += size
+            pages = (offset + size - 1) // PAGE - offset // PAGE + 1 if size else 0
+            self._make_room(pages * PAGE, key)  # whole pages: a tiny fragment still takes one
+            partial.held += pages * PAGE
+            self._held += pages * PAGE
         partial.buffer[offset : offset + size] = payload
         partial.received.add(index)
         if len(partial.received) < count:
@@ -141,11 +149,13 @@ class Reassembler:
     ) -> _Partial:
         stream = key[:3]
         older = self._latest.get(stream)
-        if older is not None and older in self._partial:
-            self._drop(older)  # a newer message started: the old one will not complete
-        self._latest[stream] = key
+        if older is None or 0 < (key[3] - older[3]) & 0xFFFFFFFF < 0x80000000:
+            if older is not None and older in self._partial:
+                self._drop(older)  # a newer message started: the old one will not complete
+            self._latest[stream] = key
+        # else an older message's fragment (replayed or late): it must not end the newer one
         buffer = _buffer(total)
-        held = 0 if isinstance(buffer, mmap.mmap) else total
+        held = PARTIAL_OVERHEAD + (0 if isinstance(buffer, mmap.mmap) else total)
         self._make_room(held, key)
         partial = self._partial[key] = _Partial(buffer, count, now_ns, held)
         self._held += held

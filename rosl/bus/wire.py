@@ -4,14 +4,16 @@ A :class:`Writer` sends the messages of one endpoint (a publisher, a service cli
 server), signed when the transport has a key. A :class:`Reader` turns a receiver's datagrams
 into deliveries, and is where strangers' traffic stops:
 
-* foreign, unsigned or wrongly signed datagrams are dropped (and counted) before anything
-  else is read; so are topics nobody in the process wants;
+* foreign datagrams and topics nobody in the process wants are dropped after the header is
+  read; unsigned or wrongly signed ones before anything else is: no state, no parsing;
 * every stream — one endpoint of one process start (the sender id is drawn per start), and
   for addressed datagrams one target — keeps a sliding window over its sequence numbers: a
   message seen before is never delivered twice (duplicates, replays), and a gap is counted as
   loss only when it is at most :data:`LOSS_WINDOW` long; a bigger jump starts a new segment
-  of the stream (logged once), so no single datagram can poison the loss count. A late
-  message inside the window takes its gap back out of the loss count, so counts stay exact;
+  of the stream (logged once). A gap longer than :data:`DUP_WINDOW` counts only once the next
+  message goes on from after it, and a late message inside the window takes its gap back out
+  of the count, so a forged sequence number never leaves the count inflated while the real
+  stream goes on, and counts of real gaps stay exact;
 * a datagram outside its stream's window, or opening a stream, is taken only if its stamp
   is newer than anything that stream sent before and within :data:`FRESH_NS` of this clock:
   old datagrams replayed later are dropped as stale;
@@ -25,7 +27,9 @@ from __future__ import annotations
 
 import itertools
 import sys
+import threading
 import time
+from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -56,7 +60,8 @@ _VERSION = hdr.VERSION
 
 DUP_WINDOW = 1024  # sequence numbers behind the newest that are still told apart
 LOSS_WINDOW = 1 << 16  # a forward gap up to this is loss; a bigger jump starts a new segment
-FRESH_NS = 30_000_000_000  # a stream's first datagram must be stamped this close to our clock
+FRESH_NS = 30_000_000_000  # every datagram must be stamped this close to the receiver's clock
+BORN_SLACK_NS = 1_000_000_000  # a new stream's datagrams may predate the reader by this much
 MAX_STREAMS = 8192  # streams followed at once (each kind of stream has its own table)
 MAX_RETIRED = 16384  # streams forgotten but still protected against replays
 SILENT_NS = 10_000_000_000  # a stream silent this long is retired
@@ -99,10 +104,19 @@ class StreamStats:
     seen: int = _FULL
     stamp: int = 0  # the newest datagram stamp of the stream (the sender's clock)
     jumps: int = 0  # new segments started by a jump beyond the windows
+    pending: int = 0  # a gap bigger than DUP_WINDOW, counted when the stream goes on after it
+    # the segment a big gap or jump left: (last_seq, seen, stamp, pending, lost)
+    left: tuple[int, int, int, int, int] | None = None
+    run: int = 2  # messages since the current segment began (a new stream counts as known)
 
 
 def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> int:
     """Place one message in its stream's window: ACCEPTED or JUMPED, else DUPLICATE or STALE.
+
+    Inside :data:`DUP_WINDOW` of the newest number the bitmap decides. Leaving it (a gap of
+    more than DUP_WINDOW, a step back past it, a far jump) takes a stamp newer than anything
+    the stream sent, and keeps the segment left behind: a later message that goes on from it
+    (the real stream, after a key holder's forged detour) returns to it, its loss count too.
 
     Args:
         stats: the stream.
@@ -113,8 +127,11 @@ def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> i
     """
     result = ACCEPTED
     step = (seq - stats.last_seq) & _MASK32
-    if 0 < step <= LOSS_WINDOW:
+    if 0 < step <= DUP_WINDOW:
         if loss:
+            if stats.pending:  # the stream went on from after the big gap: it was real
+                stats.lost += stats.pending
+                stats.pending = 0
             stats.lost += step - 1
         stats.seen = ((stats.seen << step) | 1) & _FULL
         stats.last_seq = seq
@@ -125,20 +142,45 @@ def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> i
             if stats.seen & bit:
                 return DUPLICATE
             stats.seen |= bit
-            if loss and stats.lost:
-                stats.lost -= 1  # it was counted lost when the stream went past it
-        elif stamp > stats.stamp:  # far from the window, but newer than all the stream sent
-            stats.last_seq = seq
-            stats.seen = _FULL
-            stats.jumps += 1
-            result = JUMPED
+            if loss:  # it was counted lost when the stream went past it
+                if stats.pending:
+                    stats.pending -= 1
+                elif stats.lost:
+                    stats.lost -= 1
         else:
-            return STALE
-    if stamp > stats.stamp:
-        stats.stamp = stamp
+            left = stats.left
+            if left is not None and stamp > left[2] and _continues(left[0], seq):
+                stats.last_seq, stats.seen, stats.stamp, stats.pending, stats.lost = left
+                stats.left = None  # back on the segment a detour left
+                return _window(stats, seq, stamp, now, loss)
+            if stamp <= stats.stamp:
+                return STALE
+            if stats.left is None or stats.run > 1:  # a segment of one message (a jump nothing
+                # went on from) is not worth returning to: keep the one left before it
+                stats.left = (stats.last_seq, stats.seen, stats.stamp, stats.pending, stats.lost)
+            stats.run = 0
+            if step <= LOSS_WINDOW:  # a big gap: counted when the next message goes on after it
+                if loss:
+                    stats.lost += stats.pending
+                    stats.pending = step - 1
+                stats.seen = 1
+            else:  # a new segment: nothing counted
+                stats.seen = _FULL
+                stats.pending = 0
+                stats.jumps += 1
+                result = JUMPED
+            stats.last_seq = seq
+    stats.run += 1
+    if stamp > stats.stamp:  # a stamp ahead of our clock counts as now: it cannot hold the
+        stats.stamp = min(stamp, now + BORN_SLACK_NS)  # stream back until it comes true
     stats.received += 1
     stats.last_received = now
     return result
+
+
+def _continues(last_seq: int, seq: int) -> bool:
+    """Whether ``seq`` goes on from a segment whose newest number is ``last_seq``."""
+    return 0 < (seq - last_seq) & _MASK32 <= LOSS_WINDOW
 
 
 class Writer:
@@ -234,11 +276,12 @@ class Writer:
                 _MAGIC, _VERSION, kind_value, flags, 1, self.sender, number, self.topic,
                 self.type, 0, self.endpoint, total, when,
             )  # fmt: skip
-            if total < _SMALL:
-                data = head + bytes(payload)
-                if self.auth is not None:
-                    data += self.auth.mac(data)
-                self.transport.send(self.channel, [data])
+            if total < _SMALL:  # one buffer, joined once
+                if self.auth is None:
+                    self.transport.send(self.channel, [head + bytes(payload)])
+                else:
+                    mac = self.auth.mac_parts((head, payload))
+                    self.transport.send(self.channel, [b"".join((head, payload, mac))])
             else:
                 self._send([head, payload])
         else:
@@ -278,7 +321,9 @@ class Reader:
         self.log: Callable[[str], None] = _log
         self._retired: dict[tuple[int, ...], tuple[int, int]] = {}  # key -> (last_seq, stamp)
         self._folded: dict[int, list[int]] = {}  # topic -> [received, lost] of retired streams
-        self._gone: list[int] = []  # processes that said goodbye, retired at the next look
+        self._gone: deque[int] = deque(maxlen=MAX_RETIRED)  # said goodbye: retired at next look
+        self._born = time.time_ns()
+        self._lock = threading.Lock()  # retiring against counting (other threads count)
         self._next_housekeeping = 0
         self._jump_logs = 0
 
@@ -316,6 +361,9 @@ class Reader:
             if magic != _MAGIC or version != _VERSION or count == 0 or index >= count:
                 self.foreign += 1
                 continue
+            if (not want_all and topic not in wanted) or topic in ignored:
+                self.unwanted += 1  # read no further (and spend no MAC on it)
+                continue
             if flags & _SIGNED:
                 size -= MAC_SIZE
                 flags ^= _SIGNED  # a wire detail: deliveries carry the message's flags
@@ -325,8 +373,8 @@ class Reader:
             elif auth is not None:
                 self.unsigned += 1
                 continue
-            if (not want_all and topic not in wanted) or topic in ignored:
-                self.unwanted += 1
+            if not -FRESH_NS <= now - stamp <= FRESH_NS:
+                self.stale += 1  # captured long ago, or a clock far off: never delivered
                 continue
             if flags & _BATCH:
                 self._unbatch(data, size, kind, flags, sender, endpoint, topic, type_, total,
@@ -378,7 +426,8 @@ class Reader:
                 if verdict > 0:
                     self._refuse(verdict)
                     continue
-                self._jumped(sender, endpoint, stats)
+                if kind == _DATA:  # a server's replies to one client skip numbers by design
+                    self._jumped(sender, endpoint, stats)
             out.append(
                 _new_tuple(
                     Delivery,
@@ -440,7 +489,8 @@ class Reader:
                 if verdict > 0:
                     self._refuse(verdict)
                     continue
-                self._jumped(sender, endpoint, stats)
+                if loss:
+                    self._jumped(sender, endpoint, stats)
             fields = (kind, sender, endpoint, seq, topic, type_, message_stamp, now, payload,
                       None, flags)  # fmt: skip
             out.append(_new_tuple(Delivery, fields))
@@ -456,20 +506,22 @@ class Reader:
         stamp: int,
         now: int,
     ) -> StreamStats | None:
-        """Start following a stream, or None when its first datagram is stale (a replay)."""
+        """Start following a stream, or None when its first datagram is stale (a replay).
+
+        A retired stream comes back with its window (numbers up to its last are taken as
+        seen, so its old datagrams stay refused); a new one must have been sent after this
+        reader began, give or take :data:`BORN_SLACK_NS`: a datagram captured before that
+        and replayed now is refused, even to a process started since.
+        """
         retired = self._retired.pop(key, None)
         if retired is not None:
             last_seq, last_stamp = retired
-            if stamp <= last_stamp:
-                self._retired[key] = retired
-                self.stale += 1
-                return None
-            stats = StreamStats(topic, last_seq=last_seq, stamp=last_stamp)
-        elif abs(now - stamp) > FRESH_NS:
+            stats = StreamStats(topic, last_seq=last_seq, last_received=now, stamp=last_stamp)
+        elif stamp < self._born - BORN_SLACK_NS:
             self.stale += 1
             return None
         else:
-            stats = StreamStats(topic, last_seq=(seq - 1) & _MASK32)
+            stats = StreamStats(topic, last_seq=(seq - 1) & _MASK32, last_received=now)
         if len(table) >= MAX_STREAMS:
             self._evict(table, now)
         table[key] = stats
@@ -495,15 +547,16 @@ class Reader:
 
     def forget(self, sender: int) -> None:
         """A process said goodbye: retire its streams (at the next look; any thread)."""
-        if len(self._gone) < MAX_RETIRED:  # a reader nobody polls must not grow either
-            self._gone.append(sender)
+        self._gone.append(sender)  # bounded: a reader nobody polls must not grow either
 
     def _housekeeping(self, now: int) -> None:
         """Expire fragments, retire silent streams and those of processes that said bye."""
         self._next_housekeeping = now + HOUSEKEEPING_NS
         if self.reassembler.pending:  # drop (and count) messages whose fragments stopped
             self.reassembler.expire(now)
-        gone, self._gone = set(self._gone), []
+        gone = set()
+        while self._gone:
+            gone.add(self._gone.popleft())
         for table in (self.streams, self.others):
             for key, stats in list(table.items()):
                 if key[0] in gone or now - stats.last_received > SILENT_NS:
@@ -520,17 +573,19 @@ class Reader:
                 self._retire(table, key)
 
     def _retire(self, table: dict[Any, StreamStats], key: tuple[int, ...]) -> None:
-        stats = table.pop(key, None)
-        if stats is None:
-            return
-        self.retired += 1
-        if len(self._retired) >= MAX_RETIRED:
-            del self._retired[next(iter(self._retired))]  # the oldest retirement
-        self._retired[key] = (stats.last_seq, stats.stamp)
-        if table is self.streams and (self.want_all or stats.topic in self.wanted):
-            folded = self._folded.setdefault(stats.topic, [0, 0])
-            folded[0] += stats.received
-            folded[1] += stats.lost
+        with self._lock:
+            stats = table.pop(key, None)
+            if stats is None:
+                return
+            self.retired += 1
+            if len(self._retired) >= MAX_RETIRED:
+                del self._retired[next(iter(self._retired))]  # the oldest retirement
+            self._retired[key] = (stats.last_seq, stats.stamp)
+            wanted = self.want_all or stats.topic in self.wanted
+            if table is self.streams and wanted and len(self._folded) < MAX_STREAMS:
+                folded = self._folded.setdefault(stats.topic, [0, 0])
+                folded[0] += stats.received
+                folded[1] += stats.lost
 
     # --- counts (any thread) ---------------------------------------------------------------------
 
@@ -544,8 +599,9 @@ class Reader:
 
     def _count(self, field: int, topic: int | None) -> int:
         # snapshots: the polling thread adds and retires streams while other threads count
-        live = tuple(self.streams.values())
-        folded = tuple(self._folded.items())
+        with self._lock:
+            live = tuple(self.streams.values())
+            folded = tuple(self._folded.items())
         total = sum(f[1][field] for f in folded if topic is None or f[0] == topic)
         if field:
             return total + sum(s.lost for s in live if topic is None or s.topic == topic)

@@ -40,6 +40,7 @@ DISCOVERY_TOPIC = "@discovery"
 DISCOVERY_TYPE = "rosl/discovery/1"
 PERIOD_S = 1.0
 SELFTEST_S = 2.0
+REASSEMBLY_BUDGET = 8 * 1024 * 1024  # announcements are small: strangers' fragments get little
 HOST = platform.node()
 
 
@@ -77,6 +78,7 @@ class Discovery:
         self._receiver = transport.receiver()
         self._reader = self._receiver.reader
         self._reader.wanted.add(self._writer.topic)
+        self._reader.reassembler.budget = REASSEMBLY_BUDGET
         self._receiver.join(0)
         self._version = itertools.count(1)
         self._query_ids = itertools.count(1)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind, topic_hash
+from rosl.bus.wire import DUP_WINDOW, LOSS_WINDOW
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from rosl.bus.wire import Delivery
 
 NS = 1e9
+MAX_PUBLISHERS = 4096  # publisher streams followed for loss
 
 
 @dataclass(slots=True)
@@ -55,10 +57,18 @@ class Window:
 
     def note_seq(self, sender: int, endpoint: int, seq: int) -> None:
         """Follow one publisher's sequence numbers: a gap is lost messages."""
-        previous = self.last_seq.get((sender, endpoint))
-        if previous is not None and 0 < seq - previous < 1 << 31:
-            self.lost += seq - previous - 1
-        self.last_seq[(sender, endpoint)] = seq
+        key = (sender, endpoint)
+        previous = self.last_seq.get(key)
+        if previous is None:
+            if len(self.last_seq) < MAX_PUBLISHERS:  # made-up senders must not grow the table
+                self.last_seq[key] = seq
+            return
+        step = (seq - previous) & 0xFFFFFFFF
+        if 0 < step <= LOSS_WINDOW:
+            self.lost += step - 1
+            self.last_seq[key] = seq
+        elif (previous - seq) & 0xFFFFFFFF >= DUP_WINDOW:  # a jump: a new segment, not loss
+            self.last_seq[key] = seq
 
 
 class Tap:

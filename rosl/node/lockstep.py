@@ -20,6 +20,7 @@ simulator then goes on without it (until it answers again) or stops, as configur
 from __future__ import annotations
 
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -64,6 +65,15 @@ class Answerer:
         self._told: dict[int, int] = {}  # source -> next_wakeup last told
         self._baseline: dict[int, dict[int, int]] = {}  # source -> id(writer) -> seq last told
         self._class: Any = None
+        self._gone: deque[int] = deque(maxlen=4096)  # simulators that left (forgotten on answer)
+        participant.discovery.on_gone.append(self._gone.append)
+
+    def _forget_gone(self) -> None:
+        """Stop answering simulators that said goodbye or whose lease ran out."""
+        while self._gone:
+            source = self._gone.popleft()
+            for table in (self.seen, self._told, self._baseline):
+                table.pop(source, None)
 
     def handled(self, delivery: Delivery) -> None:
         """Remember a lock-stepped delivery that a subscription of this process took."""
@@ -76,6 +86,7 @@ class Answerer:
 
     def answer(self, next_wakeup: int, timers_ran: bool) -> None:
         """Send one answer per simulator heard from, when it may be waiting for one."""
+        self._forget_gone()
         if not self.seen:
             return
         from rosl.idl import registry
@@ -147,6 +158,7 @@ class LockstepSource:
         self.on_stall = on_stall
         self._log = log or (lambda line: None)
         self.peers: dict[int, _Peer] = {}
+        participant.discovery.on_gone.append(self._forget)
         self._step: list[tuple[str, int, int]] = []  # (topic, our endpoint, seq) sent this step
         self._subscribers: dict[str, list[int]] = {}
         self._generation = -1
@@ -156,6 +168,10 @@ class LockstepSource:
 
         registry.get_message_class(TYPE)  # the store decodes only types it has loaded
         participant.listen(_TOPIC_HASH, self)
+
+    def _forget(self, process: int) -> None:
+        """A peer said goodbye or its lease ran out: stop waiting for it."""
+        self.peers.pop(process, None)
 
     def mark(self, publisher: Publisher) -> None:
         """Send this publisher's messages as lock-stepped."""

@@ -154,7 +154,7 @@ def test_a_malformed_batch_is_counted_and_the_next_one_still_arrives(counted: Co
     records = RECORD.pack(1, 5, 1000) + b"short"  # claims 1000 bytes, carries 5
     head = HEADER.pack(
         MAGIC, VERSION, Kind.DATA, Flags.BATCH, 1, SENDER, 1, topic_hash(TOPIC), 0, 0,
-        ENDPOINT, len(records), 5,
+        ENDPOINT, len(records), time.time_ns(),  # fresh: only the records are wrong
     )  # fmt: skip
     counted.bus.tx.send(counted.bus.writer.channel, [head + records])
     counted.bus.writer.send(b"fine")

@@ -8,7 +8,14 @@ import random
 import pytest
 
 from rosl.bus.auth import MAC_SIZE
-from rosl.bus.fragment import LAZY_ABOVE, MAX_AGE_NS, MAX_MESSAGE_SIZE, Reassembler, split
+from rosl.bus.fragment import (
+    LAZY_ABOVE,
+    MAX_AGE_NS,
+    MAX_MESSAGE_SIZE,
+    PARTIAL_OVERHEAD,
+    Reassembler,
+    split,
+)
 from rosl.bus.header import HEADER_SIZE, MAGIC, VERSION, Header, Kind
 
 CHUNK = 100  # small chunks keep the unit tests readable
@@ -353,20 +360,20 @@ def test_malformed_fragments_never_raise() -> None:
 
 def test_pending_bytes_stay_under_the_cap() -> None:
     total = 1000
-    cap = 10 * total
+    cap = 10 * (total + PARTIAL_OVERHEAD)
     r = Reassembler(budget=cap)
     for sender in range(200):
         frags = fragments(payload_of(total, seed=sender), sender=sender)
         feed(r, frags[:1])  # a partial per sender, never completed
-        assert r.pending * total <= cap
-    assert r.pending == cap // total
+        assert r.held <= cap
+    assert r.pending == 10
     assert r.held <= cap
-    assert r.evicted == 200 - cap // total
+    assert r.evicted == 200 - 10
 
 
 def test_cap_evicts_the_oldest_partial_first() -> None:
     total = 1000
-    r = Reassembler(budget=3 * total)
+    r = Reassembler(budget=3 * (total + PARTIAL_OVERHEAD))
     payloads = {s: payload_of(total, seed=s) for s in range(5)}
     frags = {s: fragments(payloads[s], sender=s) for s in payloads}
     for s in payloads:
@@ -380,7 +387,7 @@ def test_cap_evicts_the_oldest_partial_first() -> None:
 
 def test_completed_messages_free_their_share_of_the_cap() -> None:
     total = 1000
-    r = Reassembler(budget=2 * total)
+    r = Reassembler(budget=2 * (total + PARTIAL_OVERHEAD))
     for seq in range(50):
         payload = payload_of(total, seed=seq)
         assert feed(r, fragments(payload, sender=seq)) == [payload]

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
 from typing import TYPE_CHECKING
 
 import pytest
@@ -122,13 +121,22 @@ def test_another_key_can_neither_publish_call_set_nor_be_seen(processes: Process
     assert "/guarded" in out.split()
     assert "/stranger" not in out.split()  # not in our graph
     code, out, err = run(processes, ["node", "list"], theirs)
-    assert "/guarded" not in out.split()  # we are not in theirs
+    assert code == 0, err
+    assert "/stranger" in out.split()  # it sees itself ...
+    assert "/guarded" not in out.split()  # ... and not us
     code, out, err = run(processes, ["param", "set", "/guarded", "timer_period_s", "0.25"], theirs)
     assert code != 0
     assert "Node not found" in out + err
     end(stranger)
-    time.sleep(0.5)  # anything the target would have taken has been handled by now
-    assert [line for line in heard.lines if line != "up"] == []
+    # a message under our key, sent after all of the stranger's: when the target has it, it
+    # has read past everything the stranger sent
+    code, _, err = run(
+        processes, ["topic", "pub", "--once", "/guarded_in", "std_msgs/msg/String",
+                    "{data: marker}"], ours,
+    )  # fmt: skip
+    assert code == 0, err
+    assert heard.wait_line("heard marker", 30.0), heard.lines
+    assert [line for line in heard.lines if line not in ("up", "heard marker")] == []
     code, out, _ = run(processes, ["param", "get", "/guarded", "timer_period_s"], ours)
     assert "1.0" in out
 

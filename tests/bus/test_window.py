@@ -167,25 +167,83 @@ def test_a_forgotten_stream_stays_protected_and_resumes_its_loss_count(bus: Wire
     # 1-5, the look (seq 1 of another sender) and 9: the replay was not delivered
     assert bus.seqs() == [1, 2, 3, 4, 5, 1, 9]
     assert bus.reader.lost() == 2
-    assert bus.reader.stale == 5
+    assert bus.reader.duplicates == 5  # the stream came back with its window
 
 
 def test_service_streams_are_told_apart_by_target(bus: Wire) -> None:
-    # a server's responses to two clients of one process carry its one sequence counter
+    # a server numbers its responses to all clients with one counter: a client that calls
+    # rarely sees numbers far apart, and each target's stream must stand on its own
     from rosl.bus.header import ADDRESS
 
-    for seq, target in ((1, 10), (2, 11), (3, 10)):
+    def response(seq: int, target: int, stamp: int) -> bytes:
         body = ADDRESS.pack(0xC11E, target, seq) + b"answer"
         head = HEADER.pack(
             MAGIC, VERSION, Kind.RESPONSE, Flags.SIGNED | Flags.ADDRESSED, 1, SENDER, seq,
-            TOPIC_HASH, TYPE_HASH, 0, 4, len(body), time.time_ns(),
+            TOPIC_HASH, TYPE_HASH, 0, 4, len(body), stamp,
         )  # fmt: skip
-        datagram = head + body + bus.auth.mac(head + body)
-        bus.send(datagram, datagram)  # each twice
+        return head + body + bus.auth.mac(head + body)
+
+    early = time.time_ns()
+    late = response(3000, 11, early + 1_000_000)
+    bus.send(late, late)  # twice: the second is a duplicate
+    bus.send(response(1, 10, early))  # far behind 3000 and older: only its own stream takes it
     bus.marker(1)
     got = [(d.seq, d.address) for d in bus.collector.snapshot() if d.kind == Kind.RESPONSE]
-    assert got == [(1, (0xC11E, 10, 1)), (2, (0xC11E, 11, 2)), (3, (0xC11E, 10, 3))]
-    assert bus.reader.duplicates == 3
+    assert got == [(3000, (0xC11E, 11, 3000)), (1, (0xC11E, 10, 1))]
+    assert bus.reader.duplicates == 1
+
+
+def test_every_datagram_must_be_fresh(bus: Wire) -> None:
+    now = time.time_ns()
+    for seq in (1, 2, 4):  # 3 is lost
+        bus.send(bus.datagram(seq))
+    bus.send(bus.datagram(3, stamp=now - wire.FRESH_NS - 1_000_000_000))  # replayed much later
+    bus.send(bus.datagram(5, stamp=now + wire.FRESH_NS + 1_000_000_000))  # from the future
+    bus.send(bus.datagram(6))
+    bus.marker(7)
+    assert bus.seqs() == [1, 2, 4, 6]
+    assert bus.reader.stale == 2
+    assert bus.reader.lost() == 2  # 3 and 5
+
+
+def test_a_stream_first_heard_must_be_younger_than_the_reader(bus: Wire) -> None:
+    born = bus.reader._born
+    captured = bus.datagram(1, sender=0xCA97, stamp=born - 5_000_000_000)  # before we started
+    bus.send(captured)
+    bus.marker(1)
+    assert bus.seqs() == []
+    assert bus.reader.stale == 1
+
+
+def test_an_old_fragment_does_not_end_a_newer_message(bus: Wire) -> None:
+    chunk = bytes(range(256)) * 100
+
+    def fragment(seq: int, index: int) -> bytes:
+        return bus.datagram(seq, chunk, kind=Kind.REQUEST, endpoint=3, count=2,
+                            index=index, total=2 * len(chunk))  # fmt: skip
+
+    bus.send(fragment(3, 0), fragment(3, 1))  # request 3, whole
+    bus.send(fragment(5, 0))  # request 5 starts
+    bus.send(fragment(3, 1))  # a fragment of request 3 again (replayed)
+    bus.send(fragment(5, 1))  # request 5 completes
+    bus.marker(1)
+    got = [d.seq for d in bus.collector.snapshot() if d.kind == Kind.REQUEST]
+    assert got == [3, 5]
+    assert bus.reader.reassembler.incomplete == 0
+
+
+def test_a_retired_stream_resumes_after_its_senders_clock_stepped_back(bus: Wire) -> None:
+    now = time.time_ns()
+    bus.send(bus.datagram(1, stamp=now), bus.datagram(2, stamp=now))
+    bus.marker(3)
+    bus.reader.forget(SENDER)
+    bus.reader._next_housekeeping = 0
+    bus.send(bus.datagram(1, sender=0x0DD))  # a look at the socket: retires the stream
+    assert bus.collector.wait_for(lambda _: (SENDER, 1) not in bus.reader.streams, 10.0)
+    stepped_back = now - 5_000_000_000  # the sender's clock went back 5 s (still fresh)
+    bus.send(bus.datagram(4, stamp=stepped_back), bus.datagram(5, stamp=stepped_back))
+    bus.marker(6)
+    assert [s for s in bus.seqs() if s > 3] == [4, 5]
 
 
 # --- bounded state ------------------------------------------------------------------------------
@@ -279,3 +337,43 @@ def test_counting_loss_while_streams_come_and_go_never_fails() -> None:
         for thread in counters:
             thread.join(10)
     assert errors == []
+
+
+def test_a_forged_detour_leaves_no_loss_once_the_real_stream_goes_on(bus: Wire) -> None:
+    for seq in range(1, 11):
+        bus.send(bus.datagram(seq))
+    forged = [bus.datagram(10 + 30_000 + n) for n in range(3)]  # a key holder's run, ahead
+    bus.send(*forged)
+    bus.marker(11)  # the real stream goes on
+    assert bus.reader.lost() == 0
+    bus.send(bus.datagram(13))  # a real gap of one, after the detour
+    bus.marker(14)
+    assert bus.reader.lost() == 1
+    bus.send(forged[0])  # the forged detour replayed: its stamp is older than the stream's
+    bus.marker(15)
+    assert bus.reader.lost() == 1
+    assert bus.reader.stale == 1
+    assert bus.seqs().count(30_010) == 1
+
+
+def test_a_real_burst_of_loss_is_counted_once_the_stream_goes_on(bus: Wire) -> None:
+    bus.send(bus.datagram(1))
+    bus.send(bus.datagram(5002))  # 5000 lost at once (more than the duplicate window)
+    bus.marker(5003)
+    assert bus.reader.lost() == 5000
+    bus.send(bus.datagram(4500))  # one of them, late, inside the window
+    bus.marker(5004)
+    assert bus.reader.lost() == 4999
+
+
+def test_a_forged_jump_stamped_ahead_does_not_hold_the_real_stream_back(bus: Wire) -> None:
+    for seq in (1, 2):
+        bus.send(bus.datagram(seq))
+    ahead = time.time_ns() + 20_000_000_000  # 20 s ahead: still fresh
+    bus.send(bus.datagram(2_000_000_000, stamp=ahead))  # a key holder's far jump
+    bus.send(bus.datagram(1_000_000_000, stamp=ahead))  # and another, far from the first
+    for seq in (3, 4):
+        bus.send(bus.datagram(seq))
+    bus.marker(5)
+    assert [s for s in bus.seqs() if s < 100] == [1, 2, 3, 4]
+    assert bus.reader.lost() == 0
