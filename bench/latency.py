@@ -5,7 +5,8 @@ std_msgs/msg/UInt8MultiArray through publishers, subscriptions and spin_once (se
 send, receive, decode, callback, on both sides). Prints median and p99 in microseconds and
 the ratios, each run measuring raw then rosl back to back, several runs, on a quiet machine
 and with a busy loop on the other core. Last, the cost of authentication per hop: rosl signed
-(the default) against rosl with ``ROSL_KEY=none``, interleaved (aim: <= 5 us per hop).
+(the default) against rosl with ``ROSL_KEY=none``, interleaved (aim: <= 5 us per hop), as
+round trips and as the CPU of one send and receive in one process (no scheduling noise).
 
     python bench/latency.py [--rounds N] [--size BYTES] [--runs R]
 """
@@ -171,6 +172,39 @@ def measure_mac(runs: int, rounds: int, size: int) -> None:
     )
 
 
+def mac_cpu(messages: int = 20000, runs: int = 5) -> None:
+    """The MAC's CPU per hop, without scheduling noise: one process sends 64 B messages to
+    itself over a socket and reads each back, signed against unsigned, interleaved."""
+    from rosl.bus import auth
+    from rosl.bus.multicast import Addressing, MulticastTransport
+    from rosl.bus.wire import Reader, Writer
+
+    key = auth.load(BENCH_DOMAIN)
+    costs: dict[bool, list[float]] = {True: [], False: []}
+    for _ in range(runs):
+        for signed in (True, False):
+            used = key if signed else None
+            tx = MulticastTransport(Addressing(BENCH_DOMAIN), used)
+            rx = MulticastTransport(Addressing(BENCH_DOMAIN), None)
+            writer = Writer(tx, 1, 1, "/bench_mac", "bench/msg/Bytes")
+            reader = Reader(used)
+            reader.want_all = True
+            sock = rx.open(writer.channel)
+            out: list = []
+            start = time.perf_counter()
+            for _ in range(messages):
+                writer.send(bytes(64))
+                reader.drain(sock.recv, out, 1)
+            costs[signed].append((time.perf_counter() - start) / messages * 1e6)
+            tx.close()
+            rx.close()
+    signed_us, unsigned_us = statistics.median(costs[True]), statistics.median(costs[False])
+    print(
+        f"mac cpu: send + receive of one 64 B message {unsigned_us:.2f} us unsigned, "
+        f"{signed_us:.2f} us signed: {signed_us - unsigned_us:+.2f} us per hop (target <= 5)"
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--rounds", type=int, default=2000)
@@ -187,6 +221,7 @@ def main() -> None:
         busy.kill()
         busy.wait()
     measure_mac(args.runs, args.rounds, args.size)
+    mac_cpu()
 
 
 if __name__ == "__main__":

@@ -54,7 +54,10 @@ def split(
         yield index, count, view[index * chunk : (index + 1) * chunk]
 
 
-LAZY_ABOVE = 1024 * 1024  # bigger buffers are anonymous mmaps: pages are faulted in as written
+# bigger buffers are anonymous mmaps: pages are faulted in as written, and given back to the OS
+# the moment the message is delivered or dropped (the heap keeps freed memory: a flood of
+# partial messages would leave the process bigger long after it ended)
+LAZY_ABOVE = 64 * 1024
 
 
 def _buffer(size: int) -> bytearray | mmap.mmap:
