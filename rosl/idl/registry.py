@@ -317,7 +317,8 @@ def msgdef_text(type_name: str) -> str:
     """The full ``ros2msg`` text of a type, as rosbag2 writes MCAP schemas.
 
     The type's own text, then each message type it uses (sorted, each once, recursively)
-    after a line of 80 ``=`` and ``MSG: pkg/msg/Name``.
+    after a line of 80 ``=`` and ``MSG: pkg/Name`` — without ``/msg/``, as rosbag2 and
+    rosbags write it and as Foxglove's ros2msg parser needs it.
 
     Raises:
         InterfaceError: unknown type.
@@ -332,7 +333,8 @@ def msgdef_text(type_name: str) -> str:
         for dependency in sorted({f.type.base for f in resolved.fields if not f.type.is_primitive}):
             if dependency not in seen:
                 seen.add(dependency)
-                result += f"\n{DELIMITER}\nMSG: {dependency}\n{text_of(dependency)}"
+                header = dependency.replace("/msg/", "/", 1)
+                result += f"\n{DELIMITER}\nMSG: {header}\n{text_of(dependency)}"
         return result
 
     key = str(parse_type_name(type_name))

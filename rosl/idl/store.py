@@ -119,10 +119,11 @@ class Store:
         """Decode CDR bytes with the definition a recording carries (its MCAP schema).
 
         ``encoding`` is ``ros2msg`` (the type's text, then each type it uses after a line of 80
-        ``=`` and ``MSG: pkg/msg/Name``) or ``ros2idl`` (sections headed ``IDL: pkg/...``). Each
-        distinct schema gets a type store of its own, apart from this process's types, so two
-        recordings may define one name differently. The result is a rosbags message object
-        (fields as attributes), not one of this process's classes.
+        ``=`` and ``MSG: pkg/Name``, or ``pkg/msg/Name`` as older rosl wrote) or ``ros2idl``
+        (sections headed ``IDL: pkg/...``). Each distinct schema gets a type store of its own,
+        apart from this process's types, so two recordings may define one name differently.
+        The result is a rosbags message object (fields as attributes), not one of this
+        process's classes.
 
         Raises:
             InterfaceError: the schema cannot be read, or the bytes are not that type.

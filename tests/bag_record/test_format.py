@@ -185,8 +185,8 @@ def test_schemas_are_ros2msg_with_the_full_message_definition(recording: Recordi
     # JointState's definition carries its dependencies, as rosbag2 writes them
     schemas = {k: v for f in support.read_mcap(recording.folder) for k, v in f.schemas.items()}
     joint_state = schemas["sensor_msgs/msg/JointState"][1]
-    assert "\nMSG: std_msgs/msg/Header\n" in joint_state
-    assert "\nMSG: builtin_interfaces/msg/Time\n" in joint_state
+    assert "\nMSG: std_msgs/Header\n" in joint_state  # as rosbag2 writes: no /msg/
+    assert "\nMSG: builtin_interfaces/Time\n" in joint_state
 
 
 def test_channels_carry_cdr_messages_and_the_offered_qos(recording: Recording) -> None:
