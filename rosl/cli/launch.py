@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from rosl.cli import render
+from rosl.cli.companion import companion_options
 from rosl.cli.options import domain_option, export_domain
 from rosl.launch import loader, runner
 
@@ -40,6 +41,7 @@ from rosl.launch import loader, runner
     metavar="[DIR]",
     help="Record everything on the bus while the launch runs (rosbag2 folder)",
 )
+@companion_options
 @domain_option
 def command(
     target: str,
@@ -47,10 +49,29 @@ def command(
     show_args: bool,
     print_plan: bool,
     record: str | None,
+    bridge: bool,
+    bridge_port: int,
+    serve: bool,
+    serve_port: int,
     domain_id: int | None,
 ) -> int:
     """Run a launch file: `rosl launch tutorial_pkg my_launch.py` or `rosl launch ./x.launch.py`."""
     export_domain(domain_id)
+    if (bridge or serve) and not (show_args or print_plan):
+        from rosl.cli.companion import companions
+
+        with companions(
+            serve=serve_port if serve else None,
+            bridge=bridge_port if bridge else None,
+            domain=domain_id,
+        ):
+            return _launch(target, rest, show_args, print_plan, record)
+    return _launch(target, rest, show_args, print_plan, record)
+
+
+def _launch(
+    target: str, rest: tuple[str, ...], show_args: bool, print_plan: bool, record: str | None
+) -> int:
     args = list(rest)
     if Path(target).is_file() or (
         target.endswith((".py", ".yaml", ".yml", ".xml")) and "/" in target

@@ -24,6 +24,7 @@ from rosl.errors import RoslError
 COMMANDS: dict[str, tuple[str, str]] = {
     "action": ("rosl.cli.planned:action", "Actions: not in rosl yet"),
     "bag": ("rosl.cli.bag", "Various rosbag related sub-commands"),
+    "bridge": ("rosl.cli.bridge", "Serve the live bus to Foxglove (foxglove_bridge)"),
     "component": ("rosl.cli.planned:component", "Components: not in rosl (C++ only)"),
     "daemon": ("rosl.cli.daemon", "rosl has no daemon: start/stop/status say so"),
     "doctor": ("rosl.cli.doctor", "Check the setup: multicast, domain, packages, graph"),

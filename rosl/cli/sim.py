@@ -8,6 +8,7 @@ from typing import Any
 import click
 
 from rosl.cli import render
+from rosl.cli.companion import companion_options
 from rosl.cli.options import domain_option
 
 
@@ -71,9 +72,19 @@ from rosl.cli.options import domain_option
     show_default=True,
     help="Lock-step: what to do when a controller stops answering",
 )
+@companion_options
 @domain_option
 def command(world: str, **options: Any) -> None:
     """Simulate a world: `rosl sim turtlebot3_world` (shipped worlds by name, or a file)."""
+    from rosl.cli.companion import companions
+
+    serve = options["serve_port"] if options["serve"] else None
+    bridge = options["bridge_port"] if options["bridge"] else None
+    with companions(serve=serve, bridge=bridge, domain=options["domain_id"]):
+        _simulate(world, options)
+
+
+def _simulate(world: str, options: dict[str, Any]) -> None:
     from rosl.sim.options import SimOptions
     from rosl.sim.runner import simulate
 

@@ -1,4 +1,7 @@
-"""``rosl viz [BAG] -o FILE``: the world, paths, last scan and frames as a picture (RViz's job)."""
+"""``rosl viz [BAG] -o FILE``: the world, paths, last scan and frames as a picture (RViz's job).
+
+``rosl viz --serve`` draws the same live, in a web page rosl serves (with the node graph).
+"""
 
 from __future__ import annotations
 
@@ -40,6 +43,20 @@ from rosl.cli.options import domain_option
     show_default=True,
     help="Live: seconds to listen before drawing",
 )
+@click.option("--serve", is_flag=True, help="Live, in a web page: the world and the node graph")
+@click.option(
+    "--port",
+    type=click.IntRange(0, 65535),
+    default=8080,
+    show_default=True,
+    help="--serve: the page's port (0: any free one)",
+)
+@click.option(
+    "--address",
+    default="127.0.0.1",
+    show_default=True,
+    help="--serve: the address to listen on (0.0.0.0: every interface)",
+)
 @domain_option
 def command(
     bag: Path | None,
@@ -47,13 +64,22 @@ def command(
     fixed_frame: str | None,
     display_config: Path | None,
     duration: float,
+    serve: bool,
+    port: int,
+    address: str,
     domain_id: int | None,
 ) -> None:
-    """Draw a bag (`rosl viz run1 -o path.png`) or the live system (`rosl viz -o now.png`)."""
+    """Draw a bag (`rosl viz run1 -o path.png`) or the live system (`rosl viz -o now.png`).
+
+    `rosl viz --serve` shows the live system in a browser page instead, updated as it runs.
+    """
     from rosl.introspection import viz
 
     if fixed_frame is None and display_config is not None:
         fixed_frame = viz.rviz_fixed_frame(display_config)
+    if serve:
+        _serve(bag, output, fixed_frame, address, port, domain_id)
+        return
 
     if bag is not None:
         if not bag.exists():
@@ -70,3 +96,26 @@ def command(
         title = "live"
     written = viz.draw(builder, target, title)
     render.lines([*([builder.note] if builder.note else []), f"wrote {written}"])
+
+
+def _serve(
+    bag: Path | None,
+    output: Path | None,
+    fixed_frame: str | None,
+    address: str,
+    port: int,
+    domain_id: int | None,
+) -> None:
+    """``--serve``: the live view in a browser page, until Ctrl-C."""
+    if bag is not None:
+        raise click.UsageError(f"--serve shows the live bus: give no BAG ({bag}), or drop --serve")
+    if output is not None:
+        raise click.UsageError("--serve draws in the browser: -o/--output is for a picture")
+    from rosl.introspection import live_view
+    from rosl.introspection.session import Session
+
+    with Session(domain_id) as session:
+        live_view.serve(
+            session, fixed_frame, address, port,
+            lambda url: render.lines([f"live view at {url} (Ctrl-C to stop)"]),
+        )  # fmt: skip
