@@ -280,8 +280,7 @@ class Writer:
                 if self.auth is None:
                     self.transport.send(self.channel, [head + bytes(payload)])
                 else:
-                    mac = self.auth.mac_parts((head, payload))
-                    self.transport.send(self.channel, [b"".join((head, payload, mac))])
+                    self.transport.send(self.channel, [self.auth.signed(head + bytes(payload))])
             else:
                 self._send([head, payload])
         else:
