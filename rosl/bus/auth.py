@@ -72,18 +72,12 @@ class Auth:
 
     def mac(self, body: Buffer) -> bytes:
         """The MAC of one datagram's header and payload (contiguous)."""
-        if len(body) <= SMALL:
-            small = self._small.copy()  # cheaper than keying anew
-            small.update(body)
-            return small.digest()
-        large = self._large.copy()
-        large.update(body)
-        return large.digest(MAC_SIZE)
+        return self.mac_parts((body,))
 
     def mac_parts(self, parts: Sequence[Buffer]) -> bytes:
         """The MAC of a datagram given as parts (scatter send: nothing is joined)."""
         if sum(len(p) for p in parts) <= SMALL:
-            small = self._small.copy()
+            small = self._small.copy()  # cheaper than keying anew
             for part in parts:
                 small.update(part)
             return small.digest()

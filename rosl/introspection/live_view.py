@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rosl.introspection.errors import IntrospectionError
-from rosl.introspection.viz import KINDS, MARKERS, ODOMETRY, VizBuilder
+from rosl.introspection.viz import MARKERS, ODOMETRY, VizBuilder, subscribe_drawable
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -200,21 +200,7 @@ class Feed:
 
     def refresh(self, graph: GraphCache) -> None:
         """Subscribe to the drawable topics that have a publisher now."""
-        from rosl.graph.records import PUBLISHER
-        from rosl.idl.registry import get_message_class
-        from rosl.node.qos import DurabilityPolicy, QoSProfile
-
-        for _, endpoint in graph.endpoints(PUBLISHER):
-            if endpoint.type not in KINDS or endpoint.name in self.topics:
-                continue
-            self.topics.add(endpoint.name)
-            latched = str(endpoint.qos.get("durability", "")).upper() == "TRANSIENT_LOCAL"
-            durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
-            self.node.create_subscription(
-                get_message_class(endpoint.type), endpoint.name,
-                self._taker(endpoint.name, endpoint.type), QoSProfile(depth=100,
-                durability=durability),
-            )  # fmt: skip
+        subscribe_drawable(self.node, graph, self.topics, self._taker, depth=100)
 
     def _taker(self, topic: str, type_name: str) -> Callable[[Any], None]:
         return lambda message: self.take(topic, type_name, message)

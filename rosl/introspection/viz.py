@@ -20,9 +20,12 @@ from rosl.introspection.tf import TfBuffer, Transform
 from rosl.sim.render import Scene, footprint_points, write
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
+    from rosl.graph.cache import GraphCache
     from rosl.introspection.session import Session
+    from rosl.node.node import Node
 
 ODOMETRY = "nav_msgs/msg/Odometry"
 SCAN = "sensor_msgs/msg/LaserScan"
@@ -249,24 +252,14 @@ def live(session: Session, fixed_frame: str | None, seconds: float) -> VizBuilde
     Late-joining is fine: /tf_static and /world_markers keep their history for new listeners.
     """
     import rosl
-    from rosl.graph.records import PUBLISHER
-    from rosl.idl.registry import get_message_class
-    from rosl.node.qos import DurabilityPolicy, QoSProfile
 
     builder = VizBuilder(fixed_frame)
     node = session.node()
     graph = session.graph(fresh=True)
     subscribed: set[str] = set()
-    for _, endpoint in graph.endpoints(PUBLISHER):
-        if endpoint.type in KINDS and endpoint.name not in subscribed:
-            subscribed.add(endpoint.name)
-            latched = str(endpoint.qos.get("durability", "")).upper() == "TRANSIENT_LOCAL"
-            qos = QoSProfile(depth=1000, durability=DurabilityPolicy.TRANSIENT_LOCAL if latched
-                             else DurabilityPolicy.VOLATILE)  # fmt: skip
-            node.create_subscription(
-                get_message_class(endpoint.type), endpoint.name,
-                _taker(builder, endpoint.name, endpoint.type), qos,
-            )  # fmt: skip
+    subscribe_drawable(
+        node, graph, subscribed, lambda name, kind: _taker(builder, name, kind), depth=1000
+    )
     if not subscribed:
         raise IntrospectionError(
             "nothing to draw on the bus: no node publishes odometry, LaserScan, TF or markers "
@@ -278,6 +271,34 @@ def live(session: Session, fixed_frame: str | None, seconds: float) -> VizBuilde
     while (left := deadline - time.monotonic()) > 0 and rosl.ok():
         executor.spin_once(timeout_sec=min(left, 0.05))
     return builder
+
+
+def subscribe_drawable(
+    node: Node,
+    graph: GraphCache,
+    subscribed: set[str],
+    callback: Callable[[str, str], Callable[[Any], None]],
+    depth: int,
+) -> None:
+    """Subscribe ``node`` to every drawable topic with a publisher not in ``subscribed``.
+
+    A transient-local publisher gets a transient-local subscription (its history arrives);
+    ``callback(topic, type)`` makes each subscription's callback; ``subscribed`` grows.
+    """
+    from rosl.graph.records import PUBLISHER
+    from rosl.idl.registry import get_message_class
+    from rosl.node.qos import DurabilityPolicy, QoSProfile
+
+    for _, endpoint in graph.endpoints(PUBLISHER):
+        if endpoint.type not in KINDS or endpoint.name in subscribed:
+            continue
+        subscribed.add(endpoint.name)
+        latched = str(endpoint.qos.get("durability", "")).upper() == "TRANSIENT_LOCAL"
+        durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+        node.create_subscription(
+            get_message_class(endpoint.type), endpoint.name,
+            callback(endpoint.name, endpoint.type), QoSProfile(depth=depth, durability=durability),
+        )  # fmt: skip
 
 
 def _footprint(urdf: str) -> Any:
