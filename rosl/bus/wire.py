@@ -149,7 +149,12 @@ def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> i
                     stats.lost -= 1
         else:
             left = stats.left
-            if left is not None and stamp > left[2] and _continues(left[0], seq):
+            if (
+                left is not None
+                and stamp > left[2]
+                and _continues(left[0], seq)
+                and not _continues(stats.last_seq, seq)  # a second real gap goes on from here
+            ):
                 stats.last_seq, stats.seen, stats.stamp, stats.pending, stats.lost = left
                 stats.left = None  # back on the segment a detour left
                 return _window(stats, seq, stamp, now, loss)
