@@ -15,7 +15,6 @@ import contextlib
 import json
 import os
 import select
-import shutil
 import signal
 import subprocess
 import time
@@ -24,6 +23,8 @@ from typing import Any
 
 import pytest
 
+from tests.debian import install
+
 CHROMIUM = Path("/usr/bin/chromium")
 # the machine's network is closed: without these chromium waits on connections it tries to make
 FLAGS = (
@@ -31,43 +32,11 @@ FLAGS = (
     "--disable-background-networking", "--disable-component-update", "--disable-sync",
     "--disable-dev-shm-usage", "--hide-scrollbars",
 )  # fmt: skip
-APT_LISTS = Path("/var/lib/apt/lists")
-APT_UPDATE_S = 300
-APT_INSTALL_S = 900
-
-
-def _apt(args: list[str], timeout: float) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "DEBIAN_FRONTEND": "noninteractive"}
-    return subprocess.run(
-        ["apt-get", *args], env=env, capture_output=True, text=True, timeout=timeout, check=False
-    )
-
-
-def _last_line(done: subprocess.CompletedProcess[str]) -> str:
-    lines = [line for line in (done.stderr + done.stdout).splitlines() if line.strip()]
-    return lines[-1] if lines else f"exit code {done.returncode}"
 
 
 def install_chromium() -> str | None:
     """Install chromium with apt-get; the reason it cannot be, or None once it is there."""
-    if CHROMIUM.exists():
-        return None
-    if os.geteuid() != 0:
-        return f"{CHROMIUM} is missing and cannot be installed: apt-get needs root"
-    if shutil.which("apt-get") is None:
-        return f"{CHROMIUM} is missing and cannot be installed: there is no apt-get here"
-    try:
-        if not any(APT_LISTS.glob("*_Packages*")):
-            _apt(["update"], APT_UPDATE_S)
-        done = _apt(["install", "-y", "chromium"], APT_INSTALL_S)
-        if done.returncode != 0:  # stale package lists: update once, then try again
-            _apt(["update"], APT_UPDATE_S)
-            done = _apt(["install", "-y", "chromium"], APT_INSTALL_S)
-    except subprocess.TimeoutExpired as err:
-        return f"apt-get did not finish within {err.timeout:.0f} s: {' '.join(map(str, err.cmd))}"
-    if done.returncode != 0 or not CHROMIUM.exists():
-        return f"apt-get install chromium failed: {_last_line(done)}"
-    return None
+    return install(["chromium"], [str(CHROMIUM)])
 
 
 @pytest.fixture(scope="session")

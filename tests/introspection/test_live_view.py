@@ -579,27 +579,29 @@ def test_a_long_odometry_path_is_thinned_not_grown_without_bound() -> None:
 @pytest.fixture
 def no_chromium(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> list[list[str]]:
     """chromium absent, as root with apt-get; the apt-get calls made are recorded."""
+    from tests import debian
     from tests.introspection import conftest
 
     calls: list[list[str]] = []
     monkeypatch.setattr(conftest, "CHROMIUM", tmp_path / "no-chromium")
-    monkeypatch.setattr(conftest.os, "geteuid", lambda: 0)
-    monkeypatch.setattr(conftest.shutil, "which", lambda name: f"/usr/bin/{name}")
-    monkeypatch.setattr(conftest, "APT_LISTS", tmp_path)  # no package lists yet
+    monkeypatch.setattr(debian.os, "geteuid", lambda: 0)
+    monkeypatch.setattr(debian.shutil, "which", lambda name: f"/usr/bin/{name}")
+    monkeypatch.setattr(debian, "APT_LISTS", tmp_path)  # no package lists yet
 
     def apt(args: list[str], timeout: float) -> object:
         raise AssertionError(f"apt-get {' '.join(args)} would run")
 
-    monkeypatch.setattr(conftest, "_apt", apt)  # a test that expects apt-get replaces this
+    monkeypatch.setattr(debian, "_apt", apt)  # a test that expects apt-get replaces this
     return calls
 
 
 def test_chromium_cannot_be_installed_without_root(
     no_chromium: list[list[str]], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    from tests import debian
     from tests.introspection import conftest
 
-    monkeypatch.setattr(conftest.os, "geteuid", lambda: 1000)
+    monkeypatch.setattr(debian.os, "geteuid", lambda: 1000)
 
     reason = conftest.install_chromium()
 
@@ -610,9 +612,10 @@ def test_chromium_cannot_be_installed_without_root(
 def test_chromium_cannot_be_installed_without_apt_get(
     no_chromium: list[list[str]], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    from tests import debian
     from tests.introspection import conftest
 
-    monkeypatch.setattr(conftest.shutil, "which", lambda name: None)
+    monkeypatch.setattr(debian.shutil, "which", lambda name: None)
 
     assert conftest.install_chromium() == (
         f"{conftest.CHROMIUM} is missing and cannot be installed: there is no apt-get here"
@@ -624,6 +627,7 @@ def test_a_failed_install_updates_once_retries_and_says_why(
 ) -> None:
     import subprocess
 
+    from tests import debian
     from tests.introspection import conftest
 
     def apt(args: list[str], timeout: float) -> subprocess.CompletedProcess[str]:
@@ -631,7 +635,7 @@ def test_a_failed_install_updates_once_retries_and_says_why(
         code = 0 if args == ["update"] else 100
         return subprocess.CompletedProcess(args, code, "", "E: Unable to locate package chromium")
 
-    monkeypatch.setattr(conftest, "_apt", apt)
+    monkeypatch.setattr(debian, "_apt", apt)
 
     reason = conftest.install_chromium()
 
@@ -649,13 +653,14 @@ def test_an_install_that_hangs_is_bounded(
 ) -> None:
     import subprocess
 
+    from tests import debian
     from tests.introspection import conftest
 
     def apt(args: list[str], timeout: float) -> subprocess.CompletedProcess[str]:
         raise subprocess.TimeoutExpired(["apt-get", *args], timeout)
 
-    monkeypatch.setattr(conftest, "_apt", apt)
+    monkeypatch.setattr(debian, "_apt", apt)
 
     assert conftest.install_chromium() == (
-        f"apt-get did not finish within {conftest.APT_UPDATE_S} s: apt-get update"
+        f"apt-get did not finish within {debian.APT_UPDATE_S} s: apt-get update"
     )
