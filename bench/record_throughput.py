@@ -171,6 +171,12 @@ def record_once(
     return rate, mbps, count / sent_seconds, 100.0 * (count - got) / count, told_lost
 
 
+def split_loss(loss: float, told: float, count: int) -> tuple[float, float]:
+    """(socket %, recorder %) of a run's loss %, from the recorder's count of lost in transit."""
+    socket = 100.0 * told / count if told >= 0 else float("nan")
+    return socket, max(0.0, loss - socket)
+
+
 def mcap_once(size: int, count: int, folder: Path) -> tuple[float, float]:
     """(msgs/s, MB/s) of the mcap library's Writer with the recorder's settings."""
     from mcap.well_known import MessageEncoding, SchemaEncoding
@@ -203,7 +209,8 @@ def main() -> None:
     print(f"`rosl bag record -a -o DIR` vs mcap Writer in-process; median of {args.runs} runs")
     print(
         f"{'size':>8} {'count':>6} {'pub msg/s':>10} {'rec msg/s':>10} {'rec MB/s':>9} "
-        f"{'mcap msg/s':>11} {'mcap MB/s':>10} {'ratio':>6} {'loss %':>7} {'rec lost':>8}"
+        f"{'mcap msg/s':>11} {'mcap MB/s':>10} {'ratio':>6} {'loss %':>7} {'socket %':>8} "
+        f"{'recorder %':>10}"
     )
     with tempfile.TemporaryDirectory(prefix="rosl-bench-record-") as tmp:
         folder = Path(tmp)
@@ -219,13 +226,17 @@ def main() -> None:
             columns = (statistics.median(c) for c in zip(*recs, strict=True))
             rate, mbps, pub_rate, loss, told = columns
             base_rate, base_mbps = (statistics.median(c) for c in zip(*base, strict=True))
+            socket, own = split_loss(loss, told, count)
             print(
                 f"{size:>8} {count:>6} {pub_rate:>10.0f} {rate:>10.0f} {mbps:>9.1f} "
                 f"{base_rate:>11.0f} {base_mbps:>10.1f} {mbps / base_mbps:>6.3f} {loss:>7.2f} "
-                f"{told:>8.0f}",
+                f"{socket:>8.2f} {own:>10.2f}",
                 flush=True,
             )
-        print(f"\npaced: {'size':>8} {'offered/s':>10} {'MB/s':>7} {'loss %':>7} {'rec lost':>8}")
+        print(
+            f"\npaced: {'size':>8} {'offered/s':>10} {'MB/s':>7} {'loss %':>7} {'socket %':>8} "
+            f"{'recorder %':>10}"
+        )
         for size, count, rate in PACED:
             losses = []
             for run in range(args.runs):
@@ -235,10 +246,14 @@ def main() -> None:
                 losses.append((loss, told))
                 shutil.rmtree(run_folder, ignore_errors=True)
             loss, told = max(losses)
+            socket, own = split_loss(loss, told, count)
             print(
-                f"        {size:>8} {rate:>10.0f} {rate * size / 1e6:>7.1f} {loss:>7.2f} {told:>8}"
+                f"        {size:>8} {rate:>10.0f} {rate * size / 1e6:>7.1f} {loss:>7.2f} "
+                f"{socket:>8.2f} {own:>10.2f}"
             )
     print("ratio = recorded MB/s / mcap Writer MB/s; loss = 1 - messages in the bag / sent")
+    print("socket = what never reached the recorder (its sequence gaps: 'lost in transit');")
+    print("recorder = what reached it and is not in the bag (loss - socket)")
     print("paced: the publisher held to the offered rate; the worst of the runs")
 
 

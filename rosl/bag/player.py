@@ -7,6 +7,12 @@ clock reaches its log time: the clock starts at the bag's first message (plus
 ``--read-ahead-queue-size`` messages ready. With ``--clock`` the playback clock is published on
 ``/clock`` so sim-time nodes follow the bag. On a terminal, SPACE pauses and resumes, → sends
 the next message while paused, ↑/↓ change the rate by 10%.
+
+A topic name is resolved as the ROS 2 player's publishers resolve it, in the node's namespace
+``/``: a bag written by another tool may hold ``AAA``, played on ``/AAA`` (``--topics`` and
+``--remap`` name it either way). The bag's start and length are those of the messages its files
+hold (:func:`rosl.bag.info.extent`: message indexes, not the Statistics record, which a writer
+can get wrong). Messages that are not CDR are refused as rosbag2 refuses them.
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from rosl.bag.controls import HINTS, Keyboard, Timeline
 from rosl.bag.errors import BagError
+from rosl.bag.info import extent, refuse_foreign_encodings
 from rosl.bag.reader import BagMessage, iter_bag
 from rosl.bag.trim import Scan, SourceChannel, scan, unfinished_warning
 
@@ -165,22 +172,26 @@ class Player:
         found = scan(self.bag)
         for path in found.unfinished:
             self._log(unfinished_warning(path))
-        wanted = self._select(found)
+        resolved = self._resolve(found)
+        wanted = self._select(resolved)
+        refuse_foreign_encodings(found, wanted)
         remap = dict(self.options.remap)
-        start = found.start_ns + round(self.options.start_offset * NS)
+        names = {topic: remap.get(resolved[topic], resolved[topic]) for topic in wanted}
+        span = extent(found.files)
+        start = span.start_ns + round(self.options.start_offset * NS)
         reader = threading.Thread(target=self._produce, args=(wanted, start), daemon=True)
         try:
-            self._join(found, wanted, remap)
+            self._join(found, names)
             reader.start()
             with keys:
                 self._log(f"[INFO] [{NODE}]: Set rate to {self.options.rate:g}")
                 for line in HINTS if keys.active else ():
                     self._log(f"[INFO] [{NODE}]: {line}")
-                count = sum(found.channels[t].count for t in wanted)
-                seconds = (found.end_ns - found.start_ns) / NS
+                count = sum(span.counts.get(t, 0) for t in wanted)
+                seconds = (span.end_ns - span.start_ns) / NS
                 self._log(f"[INFO] [{NODE}]: Playing {count} messages on {len(wanted)} topics "
                           f"({seconds:.1f} s of recording)")  # fmt: skip
-                self._run(keys, start, remap)
+                self._run(keys, start, names)
         finally:
             self._stop.set()
             with contextlib.suppress(queue.Empty):
@@ -192,23 +203,37 @@ class Player:
 
     # --- setup -------------------------------------------------------------------------------
 
-    def _select(self, found: Scan) -> set[str]:
-        if not self.options.topics:
-            return set(found.channels)
-        names = {"/" + name.lstrip("/") for name in self.options.topics}
-        for name in sorted(names - set(found.channels)):
-            self._log(f"[WARN] [{NODE}]: topic {name} is not in the bag")
-        return names & set(found.channels)
+    def _resolve(self, found: Scan) -> dict[str, str]:
+        """Each bag topic's full name in the player's namespace (``AAA`` is ``/AAA``)."""
+        from rosl.node.errors import InvalidNameError
+        from rosl.node.names import expand
 
-    def _join(self, found: Scan, wanted: set[str], remap: dict[str, str]) -> None:
+        resolved = {}
+        for topic in sorted(found.channels):
+            try:
+                resolved[topic] = expand(topic, NODE, "/")
+            except InvalidNameError as err:
+                self._log(f"[WARN] [{NODE}]: topic {topic!r} is not played: {err}")
+        return resolved
+
+    def _select(self, resolved: dict[str, str]) -> set[str]:
+        """The bag topics to play (``--topics`` names them resolved: ``AAA`` or ``/AAA``)."""
+        if not self.options.topics:
+            return set(resolved)
+        asked = {"/" + name.lstrip("/") for name in self.options.topics}
+        for name in sorted(asked - set(resolved.values())):
+            self._log(f"[WARN] [{NODE}]: topic {name} is not in the bag")
+        return {topic for topic, name in resolved.items() if name in asked}
+
+    def _join(self, found: Scan, names: dict[str, str]) -> None:
         """Join the bus as rosbag2_player with a publisher per topic; let discovery settle."""
         from rosl.bus.wire import Writer
         from rosl.node.participant import Participant
 
         participant = self.participant = Participant(self.options.domain)
-        for topic in sorted(wanted):
+        for topic in sorted(names):
             channel = found.channels[topic]
-            name = remap.get(topic, topic)
+            name = names[topic]
             writer = Writer(
                 participant.transport, participant.sender, participant.next_endpoint(),
                 name, channel.type,
@@ -223,17 +248,17 @@ class Player:
                 "/clock", "rosgraph_msgs/msg/Clock",
             )  # fmt: skip
         self._answer_typedefs(found)
-        self._index = participant.add_node(lambda: self._describe(found, remap))
+        self._index = participant.add_node(lambda: self._describe(found, names))
         participant.discovery.changed()
         participant.discovery.wait_complete(participant.discovery.query(), timeout=1.0)
         self._stop.wait(self.options.discovery_wait)
 
-    def _describe(self, found: Scan, remap: dict[str, str]) -> NodeRecord:
+    def _describe(self, found: Scan, names: dict[str, str]) -> NodeRecord:
         from rosl.graph.records import PUBLISHER, EndpointRecord, NodeRecord
 
         assert self.participant is not None
         endpoints = [
-            EndpointRecord(PUBLISHER, remap.get(topic, topic), found.channels[topic].type,
+            EndpointRecord(PUBLISHER, names[topic], found.channels[topic].type,
                            outlet.writer.endpoint, outlet.qos, {"sent": outlet.writer.sent})
             for topic, outlet in self._outlets.items()
         ]  # fmt: skip
@@ -312,7 +337,7 @@ class Player:
 
     # --- playing -----------------------------------------------------------------------------
 
-    def _run(self, keys: Keyboard, start: int, remap: dict[str, str]) -> None:
+    def _run(self, keys: Keyboard, start: int, names: dict[str, str]) -> None:
         item = self._take(keys, None)  # the first message is read before the clock starts
         timeline = Timeline(start, self.options.rate)
         timeline.paused = self.options.start_paused
@@ -327,7 +352,7 @@ class Player:
                 raise item
             elif self._wait_for(item.log_time, keys, timeline):
                 self._outlets[item.topic].send(item.data)
-                name = remap.get(item.topic, item.topic)
+                name = names[item.topic]
                 self.result.played[name] = self.result.played.get(name, 0) + 1
             item = self._take(keys, timeline)
         self.result.stopped = self._stop.is_set()

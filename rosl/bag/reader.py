@@ -1,7 +1,8 @@
-"""Reading recordings: a rosbag2 folder, a folder of MCAP files, one MCAP file.
+"""Reading recordings: a rosbag2 folder, a folder of MCAP or ``.db3`` files, one such file.
 
 A file without its summary (a recorder that was killed) is read record by record up to the
-last complete one, and said so; ``rosl bag reindex`` rewrites it whole.
+last complete one, and said so; ``rosl bag reindex`` rewrites it whole. ``.db3`` files
+(rosbag2's sqlite3 storage) are read by :mod:`rosl.bag.sqlite`.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
 
-from rosl.bag import metadata
+from rosl.bag import metadata, sqlite
 from rosl.bag.errors import BagError
 
 if TYPE_CHECKING:
@@ -37,18 +38,20 @@ class BagMessage:
 
 
 def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
-    """The MCAP files of a bag (folder or file) and its metadata, if any.
+    """The MCAP or ``.db3`` files of a bag (folder or file) and its metadata, if any.
 
     Raises:
-        BagError: missing target, no MCAP files, metadata naming missing files, not MCAP.
+        BagError: missing target, no bag files, metadata naming missing files, a file that is
+            not MCAP (not SQLite for ``.db3``), a compressed sqlite3 bag.
     """
     if not target.exists():
         raise BagError(f"no recording at '{target}'")
     if target.is_file():
-        check_magic(target)
+        _check(target)
         return [target], None
     if (target / "metadata.yaml").is_file():
         info = metadata.read(target)
+        sqlite.check_compression(target, info)
         files = [target / name for name in info["relative_file_paths"]]
         missing = [str(p.name) for p in files if not p.is_file()]
         if missing:
@@ -58,12 +61,19 @@ def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
             )
     else:
         info = None
-        files = split_order(target.glob("*.mcap"))
+        files = split_order([*target.glob("*.mcap"), *target.glob(f"*{sqlite.SUFFIX}")])
         if not files:
-            raise BagError(f"'{target}' holds no metadata.yaml and no .mcap files")
+            raise BagError(f"'{target}' holds no metadata.yaml and no .mcap or .db3 files")
     for path in files:
-        check_magic(path)
+        _check(path)
     return files, info
+
+
+def _check(path: Path) -> None:
+    if sqlite.is_db3(path):
+        sqlite.check(path)
+    else:
+        check_magic(path)
 
 
 def split_order(paths: Iterable[Path]) -> list[Path]:
@@ -82,23 +92,29 @@ def split_order(paths: Iterable[Path]) -> list[Path]:
     return sorted(paths, key=key)
 
 
-def check_magic(path: Path) -> None:
-    """Raise a one-line BagError unless ``path`` starts with the MCAP magic.
+def check_magic(
+    path: Path,
+    magic: bytes = MAGIC,
+    refusal: str = "is not an MCAP file (it does not start with the MCAP magic)",
+) -> None:
+    """Raise a one-line BagError (``path`` and ``refusal``) unless ``path`` starts with ``magic``.
 
     Raises:
-        BagError: the file cannot be read or is not MCAP.
+        BagError: the file cannot be read or does not start so.
     """
     try:
         with path.open("rb") as handle:
-            head = handle.read(len(MAGIC))
+            head = handle.read(len(magic))
     except OSError as err:
         raise BagError(f"cannot read {path}: {err.strerror}") from None
-    if head != MAGIC:
-        raise BagError(f"{path} is not an MCAP file (it does not start with the MCAP magic)")
+    if head != magic:
+        raise BagError(f"{path} {refusal}")
 
 
 def has_summary(path: Path) -> bool:
-    """Whether an MCAP file ends with its footer (was finished properly)."""
+    """Whether an MCAP file ends with its footer (was finished properly); a ``.db3`` always is."""
+    if sqlite.is_db3(path):
+        return True  # SQLite commits whole transactions: there is no torn end to repair
     with path.open("rb") as handle:
         handle.seek(0, 2)
         size = handle.tell()
@@ -109,9 +125,12 @@ def has_summary(path: Path) -> bool:
 
 
 def iter_file(path: Path, topics: set[str] | None = None) -> Iterator[BagMessage]:
-    """Messages of one MCAP file in log-time order (stream order when it is unfinished)."""
+    """Messages of one MCAP or ``.db3`` file in log-time order (stream order if unfinished)."""
     from mcap.exceptions import McapError
 
+    if sqlite.is_db3(path):
+        yield from sqlite.iter_messages(path, topics)
+        return
     with path.open("rb") as handle:
         try:
             if has_summary(path):
@@ -140,23 +159,29 @@ def _iter_indexed(handle: BinaryIO, topics: set[str] | None) -> Iterator[BagMess
         )
 
 
-def iter_records(handle: BinaryIO, topics: set[str] | None = None) -> Iterator[BagMessage]:
-    """Messages of an MCAP stream read record by record, stopping at a torn tail."""
-    from mcap.exceptions import McapError
-    from mcap.records import Channel as McapChannel
-    from mcap.records import Message, Schema
+def stream_records(handle: BinaryIO) -> Iterator[Any]:
+    """The records of an MCAP stream in file order (chunks opened), up to a torn tail."""
     from mcap.stream_reader import StreamReader
 
-    schemas: dict[int, Any] = {}
-    channels: dict[int, Any] = {}
     records = StreamReader(handle, skip_magic=False, emit_chunks=False).records
     while True:
         try:
             record = next(records)
         except StopIteration:
             return
-        except (McapError, EOFError, ValueError, KeyError, OSError, Exception):
-            return  # the torn end of an unfinished file
+        except Exception:  # the torn end of an unfinished file: whatever the library raises
+            return
+        yield record
+
+
+def iter_records(handle: BinaryIO, topics: set[str] | None = None) -> Iterator[BagMessage]:
+    """Messages of an MCAP stream read record by record, stopping at a torn tail."""
+    from mcap.records import Channel as McapChannel
+    from mcap.records import Message, Schema
+
+    schemas: dict[int, Any] = {}
+    channels: dict[int, Any] = {}
+    for record in stream_records(handle):
         if isinstance(record, Schema):
             schemas[record.id] = record
         elif isinstance(record, McapChannel):

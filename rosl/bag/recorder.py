@@ -23,19 +23,18 @@ fit, or waits too long, is counted and reported when the recording stops.
 
 from __future__ import annotations
 
-import contextlib
-import mmap
-import os
 import sys
 import time
 from collections import deque
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, BinaryIO, NamedTuple
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 from rosl.bag import metadata
 from rosl.bag.errors import BagError
+from rosl.bag.inbox import Intake, Pending
 from rosl.bag.schemas import PENDING_LIMIT_S, Schemas
 from rosl.bag.selection import RECORDER_NODE, OtherTypes, Selection, sender_name
+from rosl.bag.writer import BagFile
 from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION
 
@@ -48,9 +47,8 @@ if TYPE_CHECKING:
 
 FLUSH_EVERY_S = 1.0
 PENDING_MAX = 20000  # messages held while their topic cannot be named yet
-PENDING_BYTES = 32 * 1024 * 1024  # the bytes they may keep alive (see _Pending)
-HELD_OVERHEAD = 512  # bytes per held message besides its buffer: tuple, view, bookkeeping
-MESSAGE_RECORD = 31  # bytes of an MCAP message record besides its data
+PENDING_BYTES = 32 * 1024 * 1024  # the bytes they may keep alive (see inbox.Pending)
+LATCHED_SEEN = 4096  # messages of a latched topic remembered to drop a replayed duplicate
 _SUBSCRIPTION_QOS = {"reliability": "RELIABLE", "durability": "VOLATILE", "history": "KEEP_LAST",
                      "depth": 1000}  # fmt: skip
 
@@ -62,27 +60,22 @@ class _Topic:
     text: str
     endpoint: int
     sequence: int = 0
+    latched: bool = False  # every publisher offered transient local: its history was asked for
+    seen: set[tuple[int, int, int]] | None = None  # (sender, endpoint, seq) of a latched topic
+    order: deque[tuple[int, int, int]] | None = None  # ``seen`` oldest first, to bound it
 
-
-@dataclass(slots=True)
-class _File:
-    path: Path
-    handle: BinaryIO
-    writer: Any
-    info: metadata.FileInfo
-    schemas: dict[str, int] = field(default_factory=dict)
-    channels: dict[str, int] = field(default_factory=dict)
-    position: int = 0  # where the handle was after the last chunk went out
-    unchunked: int = 0  # message bytes in the chunk still being built
-
-    def size(self) -> int:
-        """The file's size so far, the chunk being built counted uncompressed."""
-        return self.handle.tell() + self.unchunked
-
-    def chunk_written(self) -> None:
-        """Note that the chunk being built went to the handle (a flush)."""
-        self.position = self.handle.tell()
-        self.unchunked = 0
+    def fresh(self, delivery: Delivery) -> bool:
+        """Whether a latched topic's message was not recorded yet (live or replayed)."""
+        if self.seen is None or self.order is None:
+            return True
+        key = (delivery.sender, delivery.endpoint, delivery.seq)
+        if key in self.seen:
+            return False
+        self.seen.add(key)
+        self.order.append(key)
+        if len(self.order) > LATCHED_SEEN:
+            self.seen.discard(self.order.popleft())
+        return True
 
 
 class Recorder:
@@ -101,6 +94,7 @@ class Recorder:
         compression: str | None = None,
         domain: int | str | None = None,
         log: Callable[[str], None] | None = None,
+        ros_distro: str | None = None,
     ) -> None:
         for flag, limit in (
             ("--max-bag-size", max_bag_size),
@@ -115,16 +109,17 @@ class Recorder:
         self.max_bag_duration = max_bag_duration
         self.compression = compression
         self.domain = domain
+        self.ros_distro = metadata.distro(ros_distro)
         self._log = log or (lambda line: print(line, file=sys.stderr, flush=True))
         self.participant: Participant | None = None
-        self._file: _File | None = None
+        self._file: BagFile | None = None
         self._files: list[metadata.FileInfo] = []
         self._topics: dict[str, _Topic] = {}
         self._names: dict[tuple[int, int], tuple[str, str, str]] = {}  # (topic hash, type hash)
         self._generation = -1
         self._synced = -1
         self._node_index = 0
-        self._pending = _Pending(PENDING_MAX, PENDING_BYTES)
+        self._pending = Pending(PENDING_MAX, PENDING_BYTES)
         self._schemas: Schemas | None = None
         self._failure: BagError | None = None  # the first write the disk refused
         self._last_flush = time.monotonic()
@@ -134,6 +129,7 @@ class Recorder:
         self.stopped = False
         self.sim_time = False  # set by record_at: log times come from a simulator's clock
         self._chunk_ns = 0
+        self._intake: Intake | None = None  # the thread draining the socket, while run() runs
 
     # --- lifecycle ---------------------------------------------------------------------------
 
@@ -174,7 +170,11 @@ class Recorder:
         assert self.participant is not None
         assert self._schemas is not None
         self._schemas.preload(self._wanted_types)
-        self.participant.poll(timeout, sink=self._on_delivery)
+        if self._intake is None:
+            self.participant.poll(timeout, sink=self._on_delivery)
+        else:
+            self._intake.wait(timeout)
+            self._drain_inbox()
         self._sync_graph()
         now = time.monotonic()
         if self._pending:
@@ -219,13 +219,20 @@ class Recorder:
             wall = time.monotonic()
             if self._file is not None:
                 try:
-                    self._file.writer.flush()
-                except OSError as err:
-                    raise self._failed(self._file, err) from None
-                self._file.chunk_written()
+                    self._file.flush(sync=False)
+                except BagError as err:
+                    raise self._failed(err) from None
                 if wall - self._last_flush >= FLUSH_EVERY_S:
                     self._flush()
                     self._last_flush = wall
+
+    def _drain_inbox(self) -> None:
+        """Write what the intake thread queued (in arrival order)."""
+        intake = self._intake
+        if intake is None:
+            return
+        for delivery in intake.take():
+            self._on_delivery(delivery)
 
     @property
     def held_bytes(self) -> int:
@@ -233,9 +240,21 @@ class Recorder:
         return self._pending.bytes
 
     def run(self, until: Callable[[], bool]) -> None:
-        """Record until ``until()`` is true."""
-        while not until():
-            self.step(0.1)
+        """Record until ``until()`` is true, the socket drained by a thread of its own.
+
+        The intake thread only receives (checks, reassembles) and queues; this thread writes.
+        A burst faster than the writer then waits in memory, within ``inbox.INBOX_BYTES``, instead
+        of overflowing the socket's buffer in the kernel, where it would be lost.
+        """
+        assert self.participant is not None, "start() first"
+        self._intake = Intake(self.participant)
+        try:
+            while not until():
+                self.step(0.1)
+        finally:
+            self._intake.stop()
+            self._drain_inbox()
+            self._intake = None
 
     def close(self) -> None:
         """Finish the MCAP file(s) with their index and write metadata.yaml (idempotent).
@@ -268,7 +287,7 @@ class Recorder:
         infos = [t.info for t in self._topics.values()]
         if self.sim_time:  # the same run gives the same metadata
             infos.sort(key=lambda info: info.name)
-        metadata.write(self.folder, infos, self._files)
+        metadata.write(self.folder, infos, self._files, ros_distro=self.ros_distro)
         total = sum(t.count for t in infos)
         lost = self.participant.reader.lost() if self.participant is not None else 0
         self._log(
@@ -285,23 +304,16 @@ class Recorder:
     # --- files -------------------------------------------------------------------------------
 
     def _open_file(self) -> None:
-        from mcap.writer import CompressionType, Writer
-
         index = len(self._files)
         path = self.folder / f"{self.folder.name}_{index}.mcap"
-        compression = {
-            None: CompressionType.NONE, "none": CompressionType.NONE,
-            "zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
-        }[self.compression]  # fmt: skip
-        try:
-            handle = path.open("wb")
-        except OSError as err:
-            raise BagError(f"cannot create {path}: {err.strerror}") from None
-        writer = Writer(handle, compression=compression, chunk_size=4 * 1024 * 1024)
-        writer.start(profile="ros2", library="rosl")
-        info = metadata.FileInfo(path.name)
-        self._files.append(info)
-        self._file = _File(path, handle, writer, info)
+        current = BagFile(
+            path, compression=self.compression, library="rosl",
+            version=metadata.VERSIONS[self.ros_distro],
+        )  # fmt: skip
+        self._files.append(current.info)
+        self._file = current
+        for name, topic in self._topics.items():  # as rosbag2 does: every topic in every file
+            self._channel(current, name, topic)
 
     def _close_file(self) -> None:
         current = self._file
@@ -309,38 +321,32 @@ class Recorder:
             return
         self._file = None
         if self._failure is not None:  # the disk refused a write: the file stays unfinished
-            with contextlib.suppress(OSError):
-                current.handle.close()
+            current.abandon()
             return
+        infos = [t.info for t in self._topics.values()]
+        information = metadata.information(infos, self._files, ros_distro=self.ros_distro)
         try:
-            current.writer.finish()
-            current.handle.flush()
-            os.fsync(current.handle.fileno())
-            current.handle.close()
-        except OSError as err:
-            with contextlib.suppress(OSError):
-                current.handle.close()
-            self._failure = BagError(f"cannot finish {current.path}: {err.strerror}")
-            raise self._failure from None
+            current.finish(information, self.ros_distro)
+        except BagError as err:
+            current.abandon()
+            raise self._failed(err) from None
 
     def _flush(self) -> None:
         current = self._file
         if current is None:
             return
         try:
-            current.writer.flush()
-            os.fsync(current.handle.fileno())
-        except OSError as err:
-            raise self._failed(current, err) from None
-        current.chunk_written()
+            current.flush()
+        except BagError as err:
+            raise self._failed(err) from None
 
-    def _failed(self, current: _File, err: OSError) -> BagError:
+    def _failed(self, err: BagError) -> BagError:
         """The error of a write the disk refused, kept: :meth:`close` raises it again."""
         if self._failure is None:
-            self._failure = BagError(f"cannot write {current.path}: {err.strerror} (disk full?)")
+            self._failure = err
         return self._failure
 
-    def _split_before(self, current: _File, log_time: int) -> bool:
+    def _split_before(self, current: BagFile, log_time: int) -> bool:
         """Whether a message logged at ``log_time`` belongs in a new file (rosbag2's rule)."""
         if not current.info.count:
             return False
@@ -352,10 +358,9 @@ class Recorder:
             return False
         if self.compression and current.unchunked:  # compressed, the chunk may be smaller
             try:
-                current.writer.flush()
-            except OSError as err:
-                raise self._failed(current, err) from None
-            current.chunk_written()
+                current.flush(sync=False)
+            except BagError as err:
+                raise self._failed(err) from None
         return current.size() >= self.max_bag_size
 
     # --- messages ----------------------------------------------------------------------------
@@ -368,6 +373,8 @@ class Recorder:
         """Record a delivery (or leave it out on purpose); False while it must be held."""
         if delivery.kind == Kind.DATA:
             return self._record_data(delivery)
+        if delivery.kind == Kind.REPLAY:
+            return self._record_replay(delivery)
         if self.services and delivery.kind in (Kind.REQUEST, Kind.RESPONSE):
             return self._record_service(delivery)
         return True
@@ -399,7 +406,24 @@ class Recorder:
         topic = self._subscribe(name, type_name)
         if topic is None:
             return False
-        self._write(name, topic, delivery, bytes(delivery.payload))
+        if topic.seen is None or topic.fresh(delivery):
+            self._write(name, topic, delivery, bytes(delivery.payload))
+        return True
+
+    def _record_replay(self, delivery: Delivery) -> bool:
+        """A publisher's history, sent because this recorder asked for it (transient local)."""
+        assert self.participant is not None
+        address = delivery.address
+        if address is None or address[0] != self.participant.sender:
+            return True  # another process's late subscription asked for it
+        found = self._resolve(delivery, (PUBLISHER, SUBSCRIPTION))
+        if found is None:
+            return True
+        topic = self._topics.get(found[0])
+        if topic is None or topic.endpoint != address[1] or topic.info.type != found[1]:
+            return True
+        if topic.fresh(delivery):
+            self._write(topic.info.name, topic, delivery, bytes(delivery.payload))
         return True
 
     def _record_service(self, delivery: Delivery) -> bool:
@@ -444,46 +468,20 @@ class Recorder:
             current = self._file
             assert current is not None
         try:
-            channel_id = current.channels.get(name)
-            if channel_id is None:
-                channel_id = self._register(current, name, topic)
-            current.writer.add_message(
-                channel_id=channel_id, log_time=delivery.received, data=data,
-                publish_time=delivery.stamp, sequence=topic.sequence + 1,
+            current.write(
+                self._channel(current, name, topic), delivery.received, delivery.stamp,
+                topic.sequence + 1, data,
             )  # fmt: skip
-        except OSError as err:  # a chunk went out and the disk refused it
-            raise self._failed(current, err) from None
+        except BagError as err:  # a chunk went out and the disk refused it
+            raise self._failed(err) from None
         topic.sequence += 1
-        if self.max_bag_size:
-            current.unchunked += MESSAGE_RECORD + len(data)
-            if current.handle.tell() != current.position:  # the chunk went out with it
-                current.chunk_written()
         topic.info.count += 1
-        info = current.info
-        info.count += 1
-        info.start_ns = (
-            delivery.received if info.count == 1 else min(info.start_ns, delivery.received)
-        )
-        info.end_ns = max(info.end_ns, delivery.received)
 
-    def _register(self, current: _File, name: str, topic: _Topic) -> int:
-        import yaml
-
-        type_name = topic.info.type
-        schema_id = current.schemas.get(type_name)
-        if schema_id is None:
-            schema_id = (
-                current.writer.register_schema(type_name, topic.encoding, topic.text.encode())
-                if topic.text
-                else 0
-            )
-            current.schemas[type_name] = schema_id
-        qos_text = yaml.safe_dump(topic.info.qos, sort_keys=False) if topic.info.qos else ""
-        channel_id: int = current.writer.register_channel(
-            name, "cdr", schema_id, {"offered_qos_profiles": qos_text}
-        )
-        current.channels[name] = channel_id
-        return channel_id
+    def _channel(self, current: BagFile, name: str, topic: _Topic) -> int:
+        try:
+            return current.channel(topic.info, topic.encoding, topic.text)
+        except BagError as err:
+            raise self._failed(err) from None
 
     def _other_type(self, name: str, type_name: str, delivery: Delivery) -> bool:
         """Whether ``name`` is recorded with another type (the message is counted, not written)."""
@@ -514,6 +512,17 @@ class Recorder:
         )
         topic = _Topic(info, encoding, text, self.participant.next_endpoint())
         self._topics[name] = topic
+        if self._file is not None:  # its channel now: a topic without messages is in the file
+            self._channel(self._file, name, topic)
+        if (
+            qos is None and info.qos and all(q["durability"] == "transient_local" for q in info.qos)
+        ):  # as rosbag2 asks: transient local when every publisher offers it, and then the
+            # late-joiner's history comes (what a late subscriber of the topic gets)
+            topic.latched, topic.seen, topic.order = True, set(), deque()
+            self.participant.discovery.send(
+                {"op": "replay", "topic": name,
+                 "target": [f"{self.participant.sender:016x}", topic.endpoint]}
+            )  # fmt: skip
         self._log(f"[INFO] [rosl_recorder]: Subscribed to topic '{name}'")
         self.participant.discovery.changed()
         return topic
@@ -562,7 +571,7 @@ class Recorder:
                 name,
                 t.info.type,
                 t.endpoint,
-                dict(_SUBSCRIPTION_QOS),
+                dict(_SUBSCRIPTION_QOS, durability="TRANSIENT_LOCAL" if t.latched else "VOLATILE"),
                 {"received": t.info.count},
             )
             for name, t in list(self._topics.items())
@@ -602,115 +611,3 @@ class _Ignore:
 
     def deliver(self, delivery: Delivery) -> None:
         """Unused: the recorder reads through ``poll(sink=...)``."""
-
-
-class _Held(NamedTuple):
-    delivery: Delivery
-    key: tuple[int, int]  # (topic hash, type hash)
-    buffer: int  # id() of the buffer its payload keeps alive (alive while held: unique)
-
-
-class _Pending:
-    """Messages held until their topic (or its schema) is known, oldest first, bounded.
-
-    A held payload is a view of the datagram it came in (or of a reassembled buffer) and keeps
-    that whole buffer alive, so the byte bound counts each buffer once, whole, however many held
-    messages share it (the messages of a coalesced datagram), plus ``HELD_OVERHEAD`` per
-    message. Counting only each message's own bytes would let a sender keep one small message of
-    each of many large batches (its stamps decide which are evicted first) and hold far more.
-
-    When a new message does not fit, the oldest held messages are dropped first, whatever their
-    topic. A topic about to be announced has its messages among the newest: they survive a
-    flood of strangers' topics unless the flood alone outgrows the bound in the moment before
-    the announcement, and nothing can keep them then. The other choices are worse: refusing
-    new messages when full lets a flood that came first shut out the real topic until its
-    entries age out; a per-topic share does not help, because a flood of random names gives
-    every stranger a topic of its own while the real topic, with its several messages, is the
-    biggest holder and would lose first.
-    """
-
-    def __init__(self, max_count: int, max_bytes: int) -> None:
-        self.max_count = max_count
-        self.max_bytes = max_bytes
-        self.held: deque[_Held] = deque()
-        self.since: dict[tuple[int, int], float] = {}  # only keys with messages held
-        self.counts: dict[tuple[int, int], int] = {}
-        self.buffers: dict[int, list[int]] = {}  # id -> [messages holding it, its size]
-        self.bytes = 0  # the buffers counted once each, plus the overhead per message
-
-    def __len__(self) -> int:
-        return len(self.held)
-
-    def add(self, delivery: Delivery, now: float) -> int:
-        """Hold a message; return how many messages were dropped to bound the hold."""
-        buffer, size = _retained(delivery.payload)
-        if HELD_OVERHEAD + size > self.max_bytes:  # bigger than the whole hold
-            return 1
-        ident = id(buffer)
-        dropped = 0
-        while self.held and (
-            len(self.held) >= self.max_count
-            or self.bytes + HELD_OVERHEAD + (0 if ident in self.buffers else size) > self.max_bytes
-        ):
-            self._release(self.held.popleft())
-            dropped += 1
-        key = (delivery.topic, delivery.type)
-        self.held.append(_Held(delivery, key, ident))
-        self.since.setdefault(key, now)
-        self.counts[key] = self.counts.get(key, 0) + 1
-        holders = self.buffers.get(ident)
-        if holders is None:
-            self.buffers[ident] = [1, size]
-            self.bytes += size
-        else:
-            holders[0] += 1
-        self.bytes += HELD_OVERHEAD
-        return dropped
-
-    def retry(self, take: Callable[[Delivery], bool]) -> None:
-        """Give every held message to ``take`` in order; keep those it refuses, in order."""
-        for _ in range(len(self.held)):
-            entry = self.held[0]
-            if take(entry.delivery):
-                self._release(self.held.popleft())
-            else:
-                self.held.rotate(-1)
-
-    def expire(self, now: float, limit: float) -> int:
-        """Drop the messages of topics held for more than ``limit`` seconds; return how many."""
-        old = {key for key, since in self.since.items() if now - since > limit}
-        if not old:
-            return 0
-        kept: deque[_Held] = deque()
-        for entry in self.held:
-            if entry.key in old:
-                self._release(entry)
-            else:
-                kept.append(entry)
-        dropped = len(self.held) - len(kept)
-        self.held = kept
-        return dropped
-
-    def _release(self, entry: _Held) -> None:
-        left = self.counts[entry.key] - 1
-        if left:
-            self.counts[entry.key] = left
-        else:
-            del self.counts[entry.key]
-            del self.since[entry.key]
-        holders = self.buffers[entry.buffer]
-        holders[0] -= 1
-        self.bytes -= HELD_OVERHEAD
-        if not holders[0]:
-            del self.buffers[entry.buffer]
-            self.bytes -= holders[1]
-
-
-def _retained(payload: memoryview | bytearray | mmap.mmap) -> tuple[object, int]:
-    """The buffer a payload keeps alive, and its size in bytes."""
-    if not isinstance(payload, memoryview):
-        return payload, len(payload)
-    base = payload.obj
-    if isinstance(base, (bytes, bytearray, mmap.mmap)):
-        return base, len(base)
-    return (payload if base is None else base), payload.nbytes  # at least the view itself

@@ -1,114 +1,106 @@
-"""``rosl bag reindex``: make a folder whole again after a crash.
+"""``rosl bag reindex``: make a folder whole again after a crash, losing nothing it holds.
 
-Every ``*.mcap`` file is checked to be MCAP before anything is touched. Each unfinished file
-(no footer: its recorder was killed) is read up to the last complete record and rewritten with
-its index and summary, its chunk compression and its channels' metadata (the
-``offered_qos_profiles``) kept; the rewrite goes to a temporary file that replaces the original
-only once it is complete, so a failed write leaves the original as it was. Then
-``metadata.yaml`` is rebuilt from the files present in split order (``_2`` before ``_10``),
-each topic with the QoS its channel carries and the RIHS01 hash of the schema the file holds;
-topics the old ``metadata.yaml`` listed but no file holds stay, with count 0. Finished files
-are left as they are.
+Every ``*.mcap`` file is checked to be MCAP before anything is touched, then read record by
+record (:mod:`rosl.bag.salvage`). A finished file whose chunks all pass their CRC check is left
+as it is. An unfinished one (its recorder was killed, or a copy was cut off) is rewritten with
+every record that is complete before the cut, also those of a chunk cut short; a chunk whose
+CRC fails is reported and its messages left out (``keep_corrupt`` keeps them). The rewrite
+goes through the shared :class:`~rosl.bag.writer.BagFile` (the file's chunk compression, each
+channel's QoS and type hash, the bag's distro label kept) into a temporary file that replaces
+the original only once it is complete and on disk; when something could not be carried over,
+the original stays beside it as ``<name>.mcap.orig``. A file with no complete message is left
+as it was. Then ``metadata.yaml`` is rebuilt from the files in split order (``_2`` before
+``_10``); topics the old one listed that no file holds stay, with count 0. A folder that is
+already whole is said to be so, and nothing is written.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
-from typing import TYPE_CHECKING, Any, BinaryIO
+import shutil
+from typing import TYPE_CHECKING, Any
 
-from rosl.bag import metadata
+from mcap.records import Message, Schema
+
+from rosl.bag import metadata, salvage
 from rosl.bag.errors import BagError
-from rosl.bag.reader import (
-    bag_files,
-    check_magic,
-    has_summary,
-    iter_file,
-    iter_records,
-    split_order,
-)
+from rosl.bag.reader import bag_files, check_magic, has_summary, split_order
+from rosl.bag.writer import BagFile
 
 if TYPE_CHECKING:
+    from collections.abc import Iterator
     from pathlib import Path
 
-    from rosl.bag.reader import BagMessage
+    from mcap.records import Channel
 
-CHUNK_SIZE = 4 * 1024 * 1024
-
-
-def rewrite(path: Path) -> int:
-    """Rewrite an unfinished MCAP file completely; return how many messages it kept.
-
-    Raises:
-        BagError: the new file cannot be written (disk full, ...); the original is left
-            untouched and the partial copy removed.
-    """
-    temporary = path.with_name(path.name + ".reindex")
-    try:
-        with path.open("rb") as source, temporary.open("wb") as target:
-            count = _copy(source, target)
-            target.flush()
-            os.fsync(target.fileno())
-        temporary.replace(path)
-    except OSError as err:
-        with contextlib.suppress(OSError):
-            temporary.unlink(missing_ok=True)
-        reason = err.strerror or type(err).__name__
-        raise BagError(f"cannot rewrite {path}: {reason} (the file was left as it was)") from None
-    return count
+_KEPT = " kept (--keep-corrupt)"
+Previous = dict[str, dict[str, Any]]  # topic name -> its topic_metadata in the old metadata.yaml
 
 
-def _copy(source: BinaryIO, target: BinaryIO) -> int:
-    """Write the complete records of ``source`` to ``target`` as a finished MCAP file."""
-    from mcap.writer import Writer
+class _Tally:
+    """One file's topics and counts, taken from its records (written to ``bag`` as they come)."""
 
-    writer = Writer(target, compression=_compression(source), chunk_size=CHUNK_SIZE)
-    source.seek(0)
-    writer.start(profile="ros2", library="rosl reindex")
-    schemas: dict[str, int] = {}
-    channels: dict[str, int] = {}
-    count = 0
-    for message in iter_records(source):
-        if message.type not in schemas:
-            text = message.schema_text.encode()
-            schemas[message.type] = (
-                writer.register_schema(message.type, message.schema_encoding, text)
-                if message.schema_encoding
-                else 0
-            )
-        if message.topic not in channels:
-            channels[message.topic] = writer.register_channel(  # offered QoS kept
-                message.topic, "cdr", schemas[message.type], dict(message.channel_metadata)
-            )
-        writer.add_message(
-            channels[message.topic], message.log_time, message.data, message.publish_time,
-            message.sequence,
-        )  # fmt: skip
-        count += 1
-    writer.finish()
-    return count
+    def __init__(self, name: str, previous: Previous, bag: BagFile | None = None) -> None:
+        self.info = metadata.FileInfo(name)
+        self.topics: dict[str, metadata.TopicInfo] = {}
+        self.skipped = 0  # messages of an unknown channel, or of another type than its topic's
+        self._previous = previous
+        self._bag = bag
+        self._schemas: dict[int, Schema] = {}
+        self._channels: dict[int, tuple[metadata.TopicInfo, int] | None] = {}
+
+    def take(self, record: salvage.Record) -> None:
+        """Count (and write) one record."""
+        if isinstance(record, Message):
+            found = self._channels.get(record.channel_id)
+            if found is None:
+                self.skipped += 1
+                return
+            topic, channel_id = found
+            if self._bag is not None:
+                self._bag.write(
+                    channel_id, record.log_time, record.publish_time, record.sequence, record.data
+                )
+            topic.count += 1
+            self.info.add(record.log_time)
+        elif isinstance(record, Schema):
+            self._schemas.setdefault(record.id, record)
+        elif record.id not in self._channels:
+            self._channels[record.id] = self._channel(record)
+
+    def _channel(self, channel: Channel) -> tuple[metadata.TopicInfo, int] | None:
+        schema = self._schemas.get(channel.schema_id)
+        old = self._previous.get(channel.topic, {})
+        type_name = schema.name if schema else str(old.get("type") or "")
+        topic = self.topics.get(channel.topic)
+        if topic is None:
+            topic = self.topics[channel.topic] = metadata.TopicInfo(
+                channel.topic, type_name, channel.message_encoding or "cdr",
+                qos=metadata.offered_qos(channel.metadata)
+                or metadata.parse_profiles(old.get("offered_qos_profiles")),
+                type_hash=channel.metadata.get("topic_type_hash")
+                or str(old.get("type_description_hash") or "") or _hash(schema),
+            )  # fmt: skip
+        elif topic.type != type_name:
+            return None  # a second type on one topic: a rosbag2 file has one channel per topic
+        if self._bag is None:
+            return topic, 0
+        text = schema.data if schema else b""
+        return topic, self._bag.channel(topic, schema.encoding if schema else "", text)
 
 
-def _compression(source: BinaryIO) -> Any:
-    """The compression of the file's first chunk (none when it holds no complete chunk)."""
-    from mcap.records import Chunk
-    from mcap.stream_reader import StreamReader
-    from mcap.writer import CompressionType
+def reindex(folder: Path, keep_corrupt: bool = False) -> list[str]:
+    """Repair a recording folder; return a line per file (and chunk left out) and one more.
 
-    kinds = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}
-    with contextlib.suppress(Exception):  # the torn end of an unfinished file
-        for record in StreamReader(source, skip_magic=False, emit_chunks=True).records:
-            if isinstance(record, Chunk):
-                return kinds.get(record.compression, CompressionType.NONE)
-    return CompressionType.NONE
-
-
-def reindex(folder: Path) -> list[str]:
-    """Repair a recording folder; return a line per file and one for the metadata.
+    Args:
+        folder: the recording folder.
+        keep_corrupt: keep the messages of chunks that fail their CRC check.
 
     Raises:
         BagError: not a folder, no .mcap files in it, a file that is not MCAP (nothing is
-            changed then), or a file that cannot be rewritten.
+            changed then), or a file that cannot be read or rewritten (left as it was).
     """
     if not folder.is_dir():
         raise BagError(f"'{folder}' is not a recording folder")
@@ -117,79 +109,230 @@ def reindex(folder: Path) -> list[str]:
         raise BagError(f"'{folder}' holds no .mcap files to reindex")
     for path in files:  # before anything is rewritten
         check_magic(path)
-    previous = _previous_topics(folder)
-    lines = []
+    old = _old_information(folder)
+    previous: Previous = {
+        e["topic_metadata"]["name"]: e["topic_metadata"]
+        for e in (old or {}).get("topics_with_message_count") or []
+    }
+    lines: dict[Path, list[str]] = {}
+    tallies: dict[Path, _Tally] = {}
+    distros = [os.environ.get("ROS_DISTRO", "")]  # the last resort: a killed recorder's label
+    for path in filter(has_summary, files):  # finished files: are all their chunks sound?
+        scan = salvage.Scan()
+        tally = _Tally(path.name, previous)
+        for record in _records(path, scan):
+            tally.take(record)
+        distros.insert(-1, scan.distro)
+        if scan.finished and not (scan.bad or scan.unreadable or tally.skipped):
+            tallies[path], lines[path] = tally, [f"{path.name}: complete"]
+    label = metadata.labelled(old) if old else metadata.labelled({"ros_distro": _first(distros)})
     for path in files:
-        if has_summary(path):
-            lines.append(f"{path.name}: complete")
+        if path not in lines:
+            found, lines[path] = _rewrite(path, previous, label, keep_corrupt)
+            if found is not None:
+                tallies[path] = found
+    said = [line for path in files for line in lines[path]]
+    if len(tallies) == len(files) and _matches(old, files, list(tallies.values())):
+        return [*said, "metadata.yaml: matches the files; nothing was changed"]
+    topics = _topics([tallies[p] for p in files if p in tallies], previous)
+    infos = [tallies[p].info for p in files if p in tallies]
+    metadata.write(folder, topics, infos, ros_distro=label)
+    total = sum(t.count for t in topics)
+    return [*said, f"metadata.yaml: {total} messages on {len(topics)} topics"]
+
+
+def _first(names: list[str]) -> str:
+    return next((name for name in names if name), "")
+
+
+def _records(path: Path, scan: salvage.Scan, keep_bad: bool = False) -> Iterator[salvage.Record]:
+    """The records of one file (see :func:`salvage.records`).
+
+    Raises:
+        BagError: the file cannot be read.
+    """
+    try:
+        with path.open("rb") as handle:
+            yield from salvage.records(handle, scan, keep_bad)
+    except OSError as err:
+        raise BagError(f"cannot read {path}: {err.strerror or type(err).__name__}") from None
+
+
+def _rewrite(
+    path: Path, previous: Previous, label: str, keep_corrupt: bool
+) -> tuple[_Tally | None, list[str]]:
+    """Rewrite one file whole; its tally (None: left as it was) and the lines that say so.
+
+    Raises:
+        BagError: the new file cannot be written; the original is left untouched.
+    """
+    temporary = path.with_name(path.name + ".reindex")
+    scan = salvage.Scan()
+    try:
+        with path.open("rb") as handle:
+            compression = salvage.first_compression(handle)
+        bag = BagFile(
+            temporary, compression=compression if compression in ("zstd", "lz4") else "none",
+            library="rosl reindex", version=metadata.VERSIONS[label],
+        )  # fmt: skip
+        try:
+            tally = _Tally(path.name, previous, bag)
+            for record in _records(path, scan, keep_corrupt):
+                tally.take(record)
+            if tally.info.count:
+                topics = list(tally.topics.values())
+                bag.finish(metadata.information(topics, [tally.info], ros_distro=label), label)
+        finally:
+            bag.abandon()  # closed as it is, unless finished
+    except (BagError, OSError) as err:
+        _remove(temporary)
+        reason = str(err) if isinstance(err, BagError) else f"cannot read {path}: {err.strerror}"
+        raise BagError(f"{reason} ({path.name} was left as it was)") from None
+    lost = _lost(path, scan, tally, keep_corrupt)
+    lines = [f"{path.name}: {text}" for text in lost]
+    if not tally.info.count:
+        _remove(temporary)
+        lines.append(
+            f"{path.name}: holds no complete message it can vouch for; left as it was "
+            "(not listed in metadata.yaml)"
+        )
+        return None, lines
+    said = "was unfinished; rewritten" if not has_summary(path) else "rewritten"
+    said += f" with {tally.info.count} messages"
+    if scan.cut_messages:
+        said += f" ({scan.cut_messages} of them from a chunk cut short)"
+    aside = _replace(path, temporary, keep=any(not text.endswith(_KEPT) for text in lost))
+    if aside is not None:
+        said += f"; the original is kept as {aside.name}"
+    return tally, [*lines, f"{path.name}: {said}"]
+
+
+def _lost(path: Path, scan: salvage.Scan, tally: _Tally, keep_corrupt: bool) -> list[str]:
+    """What of a file could not be carried over (or only with ``keep_corrupt``), a phrase each."""
+    lost = []
+    for bad in scan.bad:
+        said = f"the chunk at byte {bad.offset} {bad.reason}; "
+        if not keep_corrupt:
+            said += f"its {bad.messages} messages were left out"
+        elif bad.readable < bad.messages:
+            said += f"{bad.readable} of its {bad.messages} messages could be read and were kept"
         else:
-            kept = rewrite(path)
-            lines.append(f"{path.name}: was unfinished; rewritten with {kept} messages")
+            said += f"its {bad.messages} messages were{_KEPT}"
+        lost.append(said)
+    if has_summary(path) and not scan.finished:
+        lost.append(f"unreadable from byte {scan.end} on")
+    if scan.unreadable:
+        lost.append(f"{scan.unreadable} records that do not parse were left out")
+    if tally.skipped:
+        lost.append(
+            f"{tally.skipped} messages of a channel it does not define (or of a second type on "
+            "a topic) were left out"
+        )
+    return lost
+
+
+def _replace(path: Path, temporary: Path, keep: bool) -> Path | None:
+    """Put the finished ``temporary`` in place of ``path``; the original's new name if kept.
+
+    Raises:
+        BagError: the disk refused; ``path`` is as it was.
+    """
+    aside = None
+    try:
+        if keep:
+            aside = next(
+                candidate
+                for candidate in (path.with_name(f"{path.name}.orig{n or ''}") for n in range(1000))
+                if not candidate.exists()
+            )
+            try:
+                os.link(path, aside)  # the original stays where it is until it is replaced
+            except OSError:
+                shutil.copy2(path, aside)  # a file system without hard links
+        temporary.replace(path)
+    except OSError as err:
+        _remove(temporary)
+        raise BagError(
+            f"cannot replace {path}: {err.strerror or type(err).__name__} (it was left as it was)"
+        ) from None
+    with contextlib.suppress(OSError):  # the renames on disk too
+        descriptor = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)
+        finally:
+            os.close(descriptor)
+    return aside
+
+
+def _remove(temporary: Path) -> None:
+    """Remove a partial rewrite (never a folder someone put in its place)."""
+    with contextlib.suppress(OSError):
+        if temporary.is_file():
+            temporary.unlink()
+
+
+def _old_information(folder: Path) -> dict[str, Any] | None:
+    """An existing, readable ``metadata.yaml``."""
+    if not (folder / "metadata.yaml").is_file():
+        return None
+    try:
+        return metadata.read(folder)
+    except BagError:
+        return None
+
+
+def _matches(old: dict[str, Any] | None, files: list[Path], tallies: list[_Tally]) -> bool:
+    """Whether the old metadata.yaml lists these files and counts what they hold."""
+    if old is None or list(old.get("relative_file_paths") or []) != [p.name for p in files]:
+        return False
+    listed = {
+        e["topic_metadata"]["name"]: e.get("message_count")
+        for e in old.get("topics_with_message_count") or []
+    }
+    counted = {topic.name: topic.count for topic in _topics(tallies, {})}
+    per_file = [(e.get("path"), e.get("message_count")) for e in old.get("files") or []]
+    return (
+        {name: n for name, n in listed.items() if n}
+        == {name: n for name, n in counted.items() if n}
+        and old.get("message_count") == sum(counted.values())
+        and per_file in ([], [(t.info.path, t.info.count) for t in tallies])
+    )
+
+
+def _topics(tallies: list[_Tally], previous: Previous) -> list[metadata.TopicInfo]:
+    """The topics of all files (counts added up), then those only the old metadata listed."""
     topics: dict[str, metadata.TopicInfo] = {}
-    infos = [_count(path, topics, previous) for path in files]
-    for name, old in previous.items():  # listed before, but no message on disk: count 0
+    for tally in tallies:
+        for topic in tally.topics.values():
+            if topic.name in topics:
+                topics[topic.name].count += topic.count
+            else:
+                topics[topic.name] = dataclasses.replace(topic)
+    for name, old in previous.items():  # listed before, but in no file: count 0
         if name not in topics:
-            qos = old.get("offered_qos_profiles")
             topics[name] = metadata.TopicInfo(
-                name, str(old.get("type", "")), qos=list(qos) if isinstance(qos, list) else [],
+                name, str(old.get("type") or ""), str(old.get("serialization_format") or "cdr"),
+                qos=metadata.parse_profiles(old.get("offered_qos_profiles")),
                 type_hash=str(old.get("type_description_hash") or ""),
             )  # fmt: skip
-    metadata.write(folder, list(topics.values()), infos)
-    lines.append(
-        f"metadata.yaml: {sum(t.count for t in topics.values())} messages on {len(topics)} topics"
-    )
-    return lines
+    return list(topics.values())
 
 
-def _previous_topics(folder: Path) -> dict[str, dict[str, Any]]:
-    """The topics an existing (readable) ``metadata.yaml`` lists, by name."""
-    if not (folder / "metadata.yaml").is_file():
-        return {}
-    try:
-        listed = metadata.read(folder).get("topics_with_message_count") or []
-    except BagError:
-        return {}
-    return {e["topic_metadata"]["name"]: e["topic_metadata"] for e in listed}
-
-
-def _count(
-    path: Path, topics: dict[str, metadata.TopicInfo], previous: dict[str, dict[str, Any]]
-) -> metadata.FileInfo:
-    """Count one file's messages into ``topics``; its entry for metadata.yaml."""
-    info = metadata.FileInfo(path.name)
-    for message in iter_file(path):
-        topic = topics.get(message.topic)
-        if topic is None:
-            old = previous.get(message.topic, {})
-            # the QoS the file's channel carries: readers (rosbags) match the topics of
-            # metadata.yaml with the channels by name, type and QoS
-            topic = topics[message.topic] = metadata.TopicInfo(
-                message.topic, message.type,
-                qos=metadata.offered_qos(message.channel_metadata),
-                type_hash=old.get("type_description_hash") or _hash(message),
-            )  # fmt: skip
-        topic.count += 1
-        info.count += 1
-        info.start_ns = (
-            message.log_time if info.count == 1 else min(info.start_ns, message.log_time)
-        )
-        info.end_ns = max(info.end_ns, message.log_time)
-    return info
-
-
-def _hash(message: BagMessage) -> str:
-    """The RIHS01 hash of a message's type: from the file's schema, else this process's type."""
+def _hash(schema: Schema | None) -> str:
+    """The RIHS01 hash of a schema's type: from its text, else this process's type."""
     from rosl.idl import registry
     from rosl.idl.errors import InterfaceError
 
-    if message.schema_encoding and message.schema_text:
-        with contextlib.suppress(InterfaceError):
+    if schema is None:
+        return ""
+    if schema.encoding and schema.data:
+        with contextlib.suppress(InterfaceError, UnicodeDecodeError):
             return registry.store().schema_type_hash(
-                message.type, message.schema_encoding, message.schema_text
+                schema.name, schema.encoding, schema.data.decode()
             )
     try:
-        registry.get_message_class(message.type)
-        return registry.store().type_hash(message.type)
+        registry.get_message_class(schema.name)
+        return registry.store().type_hash(schema.name)
     except InterfaceError:
         return ""
 

@@ -9,19 +9,19 @@ changes the chunk compression. :func:`scan` (the bag's channel table) is shared 
 
 from __future__ import annotations
 
-import os
 import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
 
-from rosl.bag import metadata
+from rosl.bag import metadata, sqlite
 from rosl.bag.errors import BagError
-from rosl.bag.reader import bag_files, has_summary, iter_bag
+from rosl.bag.info import extent, refuse_foreign_encodings
+from rosl.bag.reader import bag_files, has_summary, iter_bag, stream_records
+from rosl.bag.writer import BagFile
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from rosl.bag.reader import BagMessage
 
 NS = 1_000_000_000
 COMPRESSIONS = ("zstd", "lz4", "none")
@@ -96,15 +96,34 @@ def scan(target: Path) -> Scan:
     files, info = bag_files(target)
     found = Scan({}, 0, 0, 0, [], info, files=files)
     for path in files:
+        if sqlite.is_db3(path):
+            _scan_db3(path, found)
+            continue
         try:
             with path.open("rb") as handle:
-                if not (has_summary(path) and _scan_summary(handle, found)):
-                    found.unfinished.append(path)
+                finished = has_summary(path)
+                if not (finished and _scan_summary(handle, found)):
+                    if not finished:  # a finished file may just lack its Statistics record
+                        found.unfinished.append(path)
                     handle.seek(0)
                     _scan_records(handle, found)
         except (McapError, OSError, ValueError) as err:
             raise BagError(f"cannot read {path}: {err}") from None
     return found
+
+
+def _scan_db3(path: Path, found: Scan) -> None:
+    """Add a ``.db3`` file's topics, counts and time span (SQL aggregates, no payloads)."""
+    held = sqlite.summary(path)
+    for topic in held.topics:
+        entry = found.channels.get(topic.name)
+        if entry is None:
+            entry = found.channels[topic.name] = SourceChannel(
+                topic.name, topic.type, topic.schema_encoding, topic.schema_text.encode(),
+                topic.serialization_format, topic.channel_metadata(),
+            )  # fmt: skip
+        entry.count += topic.count
+    _span(found, held.start_ns, held.end_ns, held.count)
 
 
 def _channel(found: Scan, channel: Any, schema: Any) -> SourceChannel:
@@ -144,19 +163,11 @@ def _scan_summary(handle: BinaryIO, found: Scan) -> bool:
 
 def _scan_records(handle: BinaryIO, found: Scan) -> None:
     from mcap.records import Channel, Message, Schema
-    from mcap.stream_reader import StreamReader
 
     schemas: dict[int, Any] = {}
     channels: dict[int, SourceChannel] = {}
     start, end, count = 0, 0, 0
-    records = StreamReader(handle, skip_magic=False, emit_chunks=False).records
-    while True:
-        try:
-            record = next(records)
-        except StopIteration:
-            break
-        except Exception:
-            break  # the torn end of an unfinished file
+    for record in stream_records(handle):
         if isinstance(record, Schema):
             schemas[record.id] = record
         elif isinstance(record, Channel):
@@ -178,8 +189,13 @@ def copy(
     start: float | None = None,
     end: float | None = None,
     compression: str | None = None,
+    ros_distro: str | None = None,
+    storage: str = "mcap",
 ) -> CopyResult:
     """Write the selected messages of ``source`` to a new rosbag2 folder ``output``.
+
+    Every selected topic gets its channel and its entry in ``metadata.yaml``, also when no
+    message of it falls in the window.
 
     Args:
         source: a bag folder or MCAP file.
@@ -189,84 +205,78 @@ def copy(
         start: drop messages earlier than this many seconds after the bag's first message.
         end: drop messages later than this many seconds after the bag's first message.
         compression: ``zstd``, ``lz4`` or ``none``; None keeps the source's.
+        ros_distro: the layout of the new bag's metadata; None keeps the source's label.
+        storage: ``mcap`` (one MCAP file) or ``sqlite3`` (one ``.db3`` file, uncompressed).
 
     Raises:
         BagError: unreadable source, bad pattern or window, output not writable.
     """
     found = scan(source)
+    refuse_foreign_encodings(found)
+    label = metadata.distro(ros_distro) if ros_distro else metadata.labelled(found.info)
     pattern = _pattern(exclude)
-    wanted = {
+    wanted = sorted(
         name
         for name in found.channels
         if (topics is None or name in topics) and not (pattern and pattern.search(name))
-    }
-    low = found.start_ns + round(start * NS) if start is not None else 0
-    high = found.start_ns + round(end * NS) if end is not None else 2**64
+    )
+    first = found.start_ns
+    if start is not None or end is not None:  # the first message held, not what Statistics say
+        first = extent(found.files).start_ns
+    low = first + round(start * NS) if start is not None else 0
+    high = first + round(end * NS) if end is not None else 2**64
     if high < low:
         raise BagError(f"--end {end} is before --start {start}")
+    if storage not in ("mcap", sqlite.STORAGE):
+        raise BagError(f"unknown storage '{storage}' (mcap or {sqlite.STORAGE})")
+    if storage == sqlite.STORAGE and compression not in (None, "none"):
+        raise BagError(f"{sqlite.STORAGE} bags are written uncompressed (no --compression-format)")
     chosen = (found.compression or "none") if compression is None else compression
+    if storage == sqlite.STORAGE:
+        chosen = "none"
     result = CopyResult(output, {}, found.count, "" if chosen == "none" else chosen)
     result.warnings = [unfinished_warning(p) for p in found.unfinished]
     result.warnings += [f"warning: topic {t} is not in {source}" for t in topics or () if
                         t not in found.channels]  # fmt: skip
     _prepare(source, output)
-    path = output / f"{output.name}_0.mcap"
-    file_info = metadata.FileInfo(path.name)
+    infos = _topic_infos(found, wanted)
+    out: BagFile | sqlite.Db3File = (
+        sqlite.Db3File(output / f"{output.name}_0{sqlite.SUFFIX}", label)
+        if storage == sqlite.STORAGE
+        else BagFile(
+            output / f"{output.name}_0.mcap", compression=chosen, library="rosl bag filter",
+            version=metadata.VERSIONS[label],
+        )
+    )  # fmt: skip
     try:
-        with path.open("wb") as handle:
-            out = _Output(handle, chosen)
-            messages = iter_bag(source, wanted) if wanted else iter(())
-            for message in (m for m in messages if low <= m.log_time <= high):
-                out.add(found.channels[message.topic], message)
-                result.written[message.topic] = result.written.get(message.topic, 0) + 1
-                _extend(file_info, message.log_time)
-            out.writer.finish()
-            handle.flush()
-            os.fsync(handle.fileno())
-    except OSError as err:
-        raise BagError(f"cannot write {path}: {err.strerror}") from None
-    metadata.write(output, _topic_infos(found, result.written), [file_info], _custom(found))
-    return result
-
-
-class _Output:
-    """One MCAP file being written, with the schemas and channels registered so far."""
-
-    def __init__(self, handle: BinaryIO, compression: str) -> None:
-        from mcap.writer import CompressionType, Writer
-
-        kinds = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}
-        self.writer = Writer(
-            handle, compression=kinds.get(compression, CompressionType.NONE),
-            chunk_size=4 * 1024**2,
-        )  # fmt: skip
-        self.writer.start(profile="ros2", library="rosl bag filter")
-        self.schemas: dict[str, int] = {}
-        self.channels: dict[str, int] = {}
-
-    def add(self, channel: SourceChannel, message: BagMessage) -> None:
-        """Write one message unchanged (its channel registered the first time)."""
-        channel_id = self.channels.get(channel.topic)
-        if channel_id is None:
-            channel_id = self.channels[channel.topic] = self._register(channel)
-        self.writer.add_message(
-            channel_id, message.log_time, message.data, message.publish_time, message.sequence
-        )
-
-    def _register(self, channel: SourceChannel) -> int:
-        schema_id = self.schemas.get(channel.type)
-        if schema_id is None:
-            schema_id = self.schemas[channel.type] = (
-                self.writer.register_schema(
-                    channel.type, channel.schema_encoding, channel.schema_data
-                )
-                if channel.schema_encoding
-                else 0
+        ids = {
+            info.name: out.channel(
+                info, found.channels[info.name].schema_encoding,
+                found.channels[info.name].schema_data,
             )
-        channel_id: int = self.writer.register_channel(
-            channel.topic, channel.message_encoding, schema_id, dict(channel.metadata)
+            for info in infos
+        }  # fmt: skip
+        messages = iter_bag(source, set(wanted)) if wanted else iter(())
+        for message in (m for m in messages if low <= m.log_time <= high):
+            out.write(
+                ids[message.topic], message.log_time, message.publish_time, message.sequence,
+                message.data,
+            )  # fmt: skip
+            result.written[message.topic] = result.written.get(message.topic, 0) + 1
+        for info in infos:
+            info.count = result.written.get(info.name, 0)
+        custom = _custom(found)
+        out.finish(
+            metadata.information(
+                infos, [out.info], custom=custom, ros_distro=label, storage=storage
+            ),
+            label,
         )
-        return channel_id
+    except BaseException:
+        out.abandon()
+        raise
+    metadata.write(output, infos, [out.info], custom, ros_distro=label, storage=storage)
+    return result
 
 
 def _pattern(exclude: str | None) -> re.Pattern[str] | None:
@@ -289,26 +299,27 @@ def _prepare(source: Path, output: Path) -> None:
         raise BagError(f"cannot create '{output}': {err.strerror}") from None
 
 
-def _extend(info: metadata.FileInfo, log_time: int) -> None:
-    info.count += 1
-    info.start_ns = log_time if info.count == 1 else min(info.start_ns, log_time)
-    info.end_ns = max(info.end_ns, log_time)
-
-
-def _topic_infos(found: Scan, written: dict[str, int]) -> list[metadata.TopicInfo]:
+def _topic_infos(found: Scan, names: list[str]) -> list[metadata.TopicInfo]:
+    """The new bag's topics: QoS and type hash as the source's metadata or channels say."""
     previous = {
         e["topic_metadata"]["name"]: e["topic_metadata"]
-        for e in (found.info or {}).get("topics_with_message_count", [])
+        for e in (found.info or {}).get("topics_with_message_count") or []
     }
     infos = []
-    for name, count in written.items():
+    for name in names:
         channel = found.channels[name]
         old = previous.get(name, {})
-        qos = old.get("offered_qos_profiles")
-        info = metadata.TopicInfo(name, channel.type, count=count)
-        info.qos = list(qos) if isinstance(qos, list) else channel.offered_qos()
-        info.type_hash = str(old.get("type_description_hash") or "") or _hash(channel.type)
-        infos.append(info)
+        qos = metadata.parse_profiles(old.get("offered_qos_profiles")) or channel.offered_qos()
+        type_hash = (
+            channel.metadata.get("topic_type_hash")
+            or str(old.get("type_description_hash") or "")
+            or _hash(channel.type)
+        )
+        infos.append(
+            metadata.TopicInfo(
+                name, channel.type, channel.message_encoding, qos=qos, type_hash=type_hash
+            )
+        )
     return infos
 
 

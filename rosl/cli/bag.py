@@ -64,6 +64,11 @@ def command() -> None:
     default=None,
     help="Compress MCAP chunks",
 )
+@click.option(
+    "--distro",
+    default=None,
+    help="Write metadata.yaml for this ROS distro's rosbag2 (default: $ROS_DISTRO, else humble)",
+)
 @domain_option
 def record(topics: tuple[str, ...], all_topics: bool, output: Path | None, **options: Any) -> None:
     """Record the bus to a rosbag2 folder (MCAP)."""
@@ -79,6 +84,7 @@ def record(topics: tuple[str, ...], all_topics: bool, output: Path | None, **opt
         services=options["include_services"], include_hidden=options["include_hidden_topics"],
         max_bag_size=options["max_bag_size"], max_bag_duration=options["max_bag_duration"],
         compression=options["compression_format"], domain=options["domain_id"],
+        ros_distro=options["distro"],
     )  # fmt: skip
     stop = {"now": False}
 
@@ -97,23 +103,40 @@ def record(topics: tuple[str, ...], all_topics: bool, output: Path | None, **opt
 @command.command("info")
 @click.argument("bag", type=click.Path(path_type=Path))
 @click.option("--json", "as_json", is_flag=True, help="Print the information as JSON")
-def info(bag: Path, as_json: bool) -> None:
+@click.option("-t", "--topic-name", is_flag=True, help="Only display topic names.")
+@click.option(
+    "-v", "--verbose", is_flag=True, help="Also size contributions and service requests/responses"
+)
+@click.option("--sort", default="name", help="Sort topics and services by name, type or count")
+def info(bag: Path, as_json: bool, topic_name: bool, verbose: bool, sort: str) -> None:
     """Print information about a bag (a folder or an .mcap file)."""
     from rosl.bag import info as bag_info
 
+    if topic_name and verbose:
+        render.warn(bag_info.BOTH_FLAGS)
+    data = bag_info.summary(bag, verbose=verbose, sort=sort)
+    names = topic_name and not verbose
     if as_json:
-        render.text(json.dumps(bag_info.summary(bag), indent=2) + "\n")
+        shown = [t["name"] for t in data["topics"]] if names else data
+        render.text(json.dumps(shown, indent=2) + "\n")
+    elif names:
+        render.lines([t["name"] for t in data["topics"]])  # nothing at all when there is none
     else:
-        render.text(bag_info.text(bag))
+        render.text(bag_info.text(data))
 
 
 @command.command("reindex")
 @click.argument("bag", type=click.Path(path_type=Path))
-def reindex(bag: Path) -> None:
-    """Repair a recording whose recorder stopped abruptly (rebuild index and metadata.yaml)."""
+@click.option(
+    "--keep-corrupt",
+    is_flag=True,
+    help="Keep the messages of chunks whose CRC check fails (left out by default)",
+)
+def reindex(bag: Path, keep_corrupt: bool) -> None:
+    """Repair a recording cut short or damaged (rebuild index and metadata.yaml, lose nothing)."""
     from rosl.bag.reindex import reindex as run
 
-    render.lines(run(bag))
+    render.lines(run(bag, keep_corrupt=keep_corrupt))
 
 
 @command.command("play")
@@ -204,6 +227,9 @@ def diff(golden: Path, new: Path, **options: Any) -> int:
     default=None,
     help="Chunk compression of the output (default: the input's)",
 )
+@click.option(
+    "--distro", default=None, help="Write metadata for this ROS distro (default: the input's)"
+)
 def filter_(source: Path, output: Path, **options: Any) -> None:
     """Write a new bag with the selected topics and time window of another."""
     from rosl.bag.trim import copy
@@ -211,6 +237,7 @@ def filter_(source: Path, output: Path, **options: Any) -> None:
     result = copy(
         source, output, topics=list(options["topics"]) or None, exclude=options["exclude"],
         start=options["start"], end=options["end"], compression=options["compression_format"],
+        ros_distro=options["distro"],
     )  # fmt: skip
     for line in result.warnings:
         render.warn(line)
@@ -226,11 +253,28 @@ def filter_(source: Path, output: Path, **options: Any) -> None:
     default=None,
     help="Chunk compression of the output (default: the input's)",
 )
-def convert(source: Path, output: Path, compression_format: str | None) -> None:
-    """Rewrite a bag into one MCAP file (recompressed with --compression-format)."""
+@click.option(
+    "--distro", default=None, help="Write metadata for this ROS distro (default: the input's)"
+)
+@click.option(
+    "-s",
+    "--storage",
+    type=click.Choice(["mcap", "sqlite3"]),
+    default="mcap",
+    show_default=True,
+    help="Storage of the output: one .mcap file, or one .db3 file (rosbag2's sqlite3)",
+)
+def convert(
+    source: Path, output: Path, compression_format: str | None, distro: str | None, storage: str
+) -> None:
+    """Rewrite a bag into one MCAP file (recompressed with --compression-format) or one .db3."""
     from rosl.bag.trim import copy
 
-    result = copy(source, output, compression=compression_format)
+    if storage == "sqlite3" and compression_format not in (None, "none"):
+        raise click.UsageError("--compression-format compresses MCAP chunks, not sqlite3")
+    result = copy(
+        source, output, compression=compression_format, ros_distro=distro, storage=storage
+    )
     for line in result.warnings:
         render.warn(line)
     render.lines([result.summary()])

@@ -360,7 +360,15 @@ def loaded(type_name: str) -> bool:
 
 
 def schema(type_name: str) -> tuple[str, str]:
-    """(encoding, text) of the MCAP schema rosbag2 writes: ros2msg, or ros2idl for srv types."""
+    """(encoding, text) of the MCAP schema rosbag2 writes: ros2msg, or ros2idl for srv types.
+
+    A service's types (``pkg/srv/Name_Event`` of service introspection) have no ``.msg`` file,
+    and rosbag2 falls back to IDL for them. ros2msg cannot carry them for every reader:
+    rosbags (0.11) files any ``pkg/srv/X`` ros2msg root under ``pkg/srv/msg/X`` and then
+    neither finds nor hashes it, so a Jazzy-layout bag would not open at all. IDL is read by
+    rosbags and by Foxglove (its ros2idl parser); mcap-ros2-support (0.6) decodes ros2msg only
+    and leaves these topics undecoded.
+    """
     if "/srv/" in type_name:
         from rosl.idl.idl_text import full_idl
 

@@ -114,6 +114,15 @@ def stop_recorder(recorder: Child, sig: int = signal.SIGINT) -> str:
     return recorder.text["err"]
 
 
+def one_line_error(result: subprocess.CompletedProcess[str]) -> str:
+    """The one line a refused command printed (exit 1, no traceback)."""
+    assert result.returncode == 1, (result.returncode, result.stdout, result.stderr)
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    return lines[0]
+
+
 def rosl_run(
     *args: str,
     cwd: Path | None = None,
@@ -214,6 +223,15 @@ def sent_times(child: Child) -> list[dict[str, int]]:
 def metadata(folder: Path) -> dict[str, Any]:
     data = yaml.safe_load((folder / "metadata.yaml").read_text())
     return data["rosbag2_bagfile_information"]
+
+
+def channel_hashes(folder: Path) -> dict[str, str]:
+    """Each topic's RIHS01 hash, as its MCAP channels carry it (``topic_type_hash``)."""
+    return {
+        topic: channel.metadata.get("topic_type_hash", "")
+        for mcap_file in read_mcap(folder)
+        for topic, channel in mcap_file.channels.items()
+    }
 
 
 def topic_counts(folder: Path) -> dict[str, int]:

@@ -34,14 +34,6 @@ def snapshot(folder: Path) -> dict[str, tuple[bytes, int]]:
     }
 
 
-def one_line_error(result: CompletedProcess[str]) -> str:
-    assert result.returncode == 1, (result.returncode, result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1, result.stderr
-    assert "Traceback" not in result.stderr
-    return lines[0]
-
-
 # --- where a recording cannot go ---------------------------------------------------------------
 
 
@@ -59,7 +51,7 @@ def test_recording_into_a_non_empty_folder_fails_and_leaves_it_untouched(
     (folder / "old_run_0.mcap").write_bytes(b"\x89MCAP0\r\nprecious")
     before = snapshot(folder)
     result = record_once(tmp_path, folder)
-    line = one_line_error(result)
+    line = support.one_line_error(result)
     assert str(folder) in line
     assert "Recording" not in result.stderr
     assert snapshot(folder) == before
@@ -71,7 +63,7 @@ def test_recording_under_a_path_that_is_a_file_fails_with_one_line(
     blocker = tmp_path / "not_a_folder"
     blocker.write_text("a file\n")
     result = record_once(tmp_path, blocker / "run")
-    line = one_line_error(result)
+    line = support.one_line_error(result)
     assert "not_a_folder" in line
     assert "Recording to" not in result.stderr
     assert "Recording stopped" not in result.stderr
@@ -88,7 +80,7 @@ def test_recording_into_a_read_only_folder_fails_with_one_line(
         # root writes into a 0o500 folder; /sys refuses anyone a new folder
         target = Path("/sys/rosl_test_run") if os.access(parent, os.W_OK) else parent / "run"
         result = record_once(tmp_path, target)
-        line = one_line_error(result)
+        line = support.one_line_error(result)
         assert line.startswith(f"cannot record into '{target}': ")
         assert "Recording to" not in result.stderr
         assert list(parent.iterdir()) == []
@@ -110,7 +102,7 @@ def test_bad_record_options_are_refused_in_one_line_before_recording(
 ) -> None:
     folder = tmp_path / "run"
     result = support.rosl_run("bag", "record", "-a", *args, "-o", str(folder), cwd=tmp_path)
-    line = one_line_error(result)
+    line = support.one_line_error(result)
     assert line.startswith(start), line
     assert "Recording" not in result.stderr
     assert not folder.exists()
@@ -161,13 +153,13 @@ def test_a_folder_without_metadata_is_read_from_its_mcap_files(bag_copy: Path) -
 def test_a_file_that_is_not_mcap_is_refused_with_one_line(tmp_path: Path) -> None:
     fake = tmp_path / "fake.mcap"
     fake.write_text("this is not a recording\n")
-    line = one_line_error(support.rosl_run("bag", "info", str(fake)))
+    line = support.one_line_error(support.rosl_run("bag", "info", str(fake)))
     assert "is not an MCAP file" in line
     assert "fake.mcap" in line
     folder = tmp_path / "fake_bag"
     folder.mkdir()
     shutil.copy(fake, folder / "fake_bag_0.mcap")
-    line = one_line_error(support.rosl_run("bag", "info", str(folder)))
+    line = support.one_line_error(support.rosl_run("bag", "info", str(folder)))
     assert "is not an MCAP file" in line
 
 
@@ -178,7 +170,7 @@ def test_metadata_naming_missing_files_is_reported_in_one_line_suggesting_reinde
     data = yaml.safe_load(path.read_text())
     data["rosbag2_bagfile_information"]["relative_file_paths"].append("ghost_7.mcap")
     path.write_text(yaml.safe_dump(data, sort_keys=False))
-    line = one_line_error(support.rosl_run("bag", "info", str(bag_copy)))
+    line = support.one_line_error(support.rosl_run("bag", "info", str(bag_copy)))
     assert "ghost_7.mcap" in line
     assert "reindex" in line
     # and reindex indeed rebuilds the metadata from the files present
@@ -207,7 +199,7 @@ def test_metadata_of_the_wrong_shape_is_reported_in_one_line_naming_file_and_key
     data["rosbag2_bagfile_information"][key] = value
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     for command in (["info"], ["info", "--json"], ["diff", str(bag_copy)]):
-        line = one_line_error(support.rosl_run("bag", *command, str(bag_copy)))
+        line = support.one_line_error(support.rosl_run("bag", *command, str(bag_copy)))
         assert str(path) in line, line
         assert key in line, line
 

@@ -147,10 +147,13 @@ def test_reindex_keeps_the_offered_qos_the_unfinished_files_channels_carry(
         except Exception:  # the torn tail of the file
             pass
     assert yaml.safe_load(offered["/counter"])[0]["depth"] == 10
-    entries = {
-        e["topic_metadata"]["name"]: e["topic_metadata"]["offered_qos_profiles"]
+    entries = {  # a YAML text in the layout of Humble (the default label), a list from Jazzy on
+        e["topic_metadata"]["name"]: (
+            yaml.safe_load(qos) if isinstance(qos := e["topic_metadata"]["offered_qos_profiles"], str)
+            else qos
+        )
         for e in support.metadata(killed.folder)["topics_with_message_count"]
-    }
+    }  # fmt: skip
     assert entries["/counter"] == yaml.safe_load(offered["/counter"])
     (path,) = support.bag_files(killed.folder)
     channel = support.read_mcap_file(path).channels["/counter"]

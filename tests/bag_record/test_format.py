@@ -109,11 +109,33 @@ def recording(module_bus: DomainProcesses, module_dir: Path) -> Recording:
 TYPES = {p["topic"]: p["type"] for p in [*PUBLISHERS, LATE]}
 
 
-def test_the_folder_is_a_rosbag2_folder_with_metadata_version_9_and_mcap_storage(
-    recording: Recording,
+@pytest.fixture(scope="module")
+def jazzy(recording: Recording, module_dir: Path) -> Path:
+    """The recording rewritten with Jazzy's metadata layout (``rosl bag convert --distro``)."""
+    from rosl.bag.trim import copy
+
+    folder = module_dir / "jazzy"
+    copy(recording.folder, folder, ros_distro="jazzy")
+    return folder
+
+
+def qos_of(folder: Path) -> dict[str, list[dict[str, Any]]]:
+    """Each topic's offered_qos_profiles in metadata.yaml, parsed (a YAML text before v9)."""
+    found = {}
+    for entry in support.metadata(folder)["topics_with_message_count"]:
+        profiles = entry["topic_metadata"]["offered_qos_profiles"]
+        found[entry["topic_metadata"]["name"]] = (
+            yaml.safe_load(profiles) if isinstance(profiles, str) else profiles
+        )
+    return found
+
+
+def test_the_folder_is_a_rosbag2_folder_in_humbles_layout_with_mcap_storage(
+    recording: Recording, jazzy: Path
 ) -> None:
     info = support.metadata(recording.folder)
-    assert info["version"] == 9
+    assert (info["version"], info["ros_distro"]) == (5, "humble")  # what Humble's rosbag2 parses
+    assert support.metadata(jazzy)["version"] == 9
     assert info["storage_identifier"] == "mcap"
     files = sorted(p.name for p in recording.folder.iterdir())
     assert files == sorted(["metadata.yaml", *info["relative_file_paths"]])
@@ -140,35 +162,43 @@ def test_metadata_names_each_topics_type_and_cdr_serialization(recording: Record
         assert entries[topic]["serialization_format"] == "cdr"
 
 
-def test_offered_qos_profiles_repeat_the_publishers_qos_words(recording: Recording) -> None:
-    entries = {
-        e["topic_metadata"]["name"]: e["topic_metadata"]["offered_qos_profiles"]
-        for e in support.metadata(recording.folder)["topics_with_message_count"]
-    }
+def test_offered_qos_profiles_repeat_the_publishers_qos_in_each_layouts_form(
+    recording: Recording, jazzy: Path
+) -> None:
+    # rmw's enum numbers in a YAML text up to version 8 (rosbag2_storage qos.cpp), words in 9
+    numbers = qos_of(recording.folder)
+    words = qos_of(jazzy)
+    assert isinstance(support.metadata(recording.folder)["topics_with_message_count"][0][
+        "topic_metadata"]["offered_qos_profiles"], str)  # fmt: skip
     expected = {
-        "/chatter": {"depth": 7, "durability": "transient_local", "reliability": "reliable"},
-        "/cmd_vel": {"depth": 10, "durability": "volatile", "reliability": "reliable"},
-        "/joints": {"depth": 3, "durability": "volatile", "reliability": "best_effort"},
-    }
-    for topic, words in expected.items():
-        assert len(entries[topic]) == 1, entries[topic]
-        profile = entries[topic][0]
-        assert {k: profile[k] for k in words} == words, (topic, profile)
-        assert profile["history"] == "keep_last"
+        "/chatter": ({"depth": 7, "durability": 1, "reliability": 1},
+                     {"depth": 7, "durability": "transient_local", "reliability": "reliable"}),
+        "/cmd_vel": ({"depth": 10, "durability": 2, "reliability": 1},
+                     {"depth": 10, "durability": "volatile", "reliability": "reliable"}),
+        "/joints": ({"depth": 3, "durability": 2, "reliability": 2},
+                    {"depth": 3, "durability": "volatile", "reliability": "best_effort"}),
+    }  # fmt: skip
+    for topic, (as_numbers, as_words) in expected.items():
+        assert len(numbers[topic]) == len(words[topic]) == 1, numbers[topic]
+        assert {k: numbers[topic][0][k] for k in as_numbers} == as_numbers, topic
+        assert {k: words[topic][0][k] for k in as_words} == as_words, topic
+        assert (numbers[topic][0]["history"], words[topic][0]["history"]) == (1, "keep_last")
 
 
-def test_type_description_hash_is_rosbags_rihs01_of_the_type(recording: Recording) -> None:
+def test_type_hashes_are_rosbags_rihs01_of_the_type(recording: Recording, jazzy: Path) -> None:
     from rosbags.typesys import Stores, get_typestore
 
-    jazzy = get_typestore(Stores.ROS2_JAZZY)
+    store = get_typestore(Stores.ROS2_JAZZY)
     entries = {
         e["topic_metadata"]["name"]: e["topic_metadata"]
-        for e in support.metadata(recording.folder)["topics_with_message_count"]
+        for e in support.metadata(jazzy)["topics_with_message_count"]
     }
+    channels = {t: c for f in support.read_mcap(recording.folder) for t, c in f.channels.items()}
     for topic, type_name in TYPES.items():
         expected = support.rihs01(type_name, "ros2msg", registry.msgdef_text(type_name))
         assert entries[topic]["type_description_hash"] == expected, topic
-        assert expected == jazzy.hash_rihs01(type_name)
+        assert channels[topic].metadata["topic_type_hash"] == expected, topic
+        assert expected == store.hash_rihs01(type_name)
 
 
 def test_each_mcap_file_has_the_ros2_profile(recording: Recording) -> None:
@@ -189,15 +219,27 @@ def test_schemas_are_ros2msg_with_the_full_message_definition(recording: Recordi
     assert "\nMSG: builtin_interfaces/Time\n" in joint_state
 
 
-def test_channels_carry_cdr_messages_and_the_offered_qos(recording: Recording) -> None:
-    meta = {
-        e["topic_metadata"]["name"]: e["topic_metadata"]["offered_qos_profiles"]
-        for e in support.metadata(recording.folder)["topics_with_message_count"]
-    }
-    for mcap_file in support.read_mcap(recording.folder):
-        for topic, channel in mcap_file.channels.items():
-            assert channel.message_encoding == "cdr", topic
-            assert yaml.safe_load(channel.metadata["offered_qos_profiles"]) == meta[topic]
+def test_channels_carry_cdr_messages_and_the_offered_qos(recording: Recording, jazzy: Path) -> None:
+    for folder in (recording.folder, jazzy):
+        meta = qos_of(folder)
+        for mcap_file in support.read_mcap(folder):
+            for topic, channel in mcap_file.channels.items():
+                assert channel.message_encoding == "cdr", topic
+                assert yaml.safe_load(channel.metadata["offered_qos_profiles"]) == meta[topic]
+
+
+def test_each_file_ends_with_rosbag2s_metadata_record(recording: Recording, jazzy: Path) -> None:
+    from mcap.reader import make_reader
+
+    for folder, version in ((recording.folder, 5), (jazzy, 9)):
+        for path in sorted(folder.glob("*.mcap")):
+            with path.open("rb") as handle:
+                records = [m for m in make_reader(handle).iter_metadata() if m.name == "rosbag2"]
+            assert len(records) == 1, path
+            assert records[0].metadata["ROS_DISTRO"] == support.metadata(folder)["ros_distro"]
+            serialized = yaml.safe_load(records[0].metadata["serialized_metadata"])
+            assert serialized["version"] == version
+            assert serialized["message_count"] == support.metadata(folder)["message_count"]
 
 
 def test_payloads_are_exactly_the_cdr_bytes_the_publisher_sent(recording: Recording) -> None:

@@ -4,7 +4,7 @@ The bag is the session's service recording (topics /numbers and /words, /paramet
 and /add_two_ints service events). Expected values are computed from the files with
 ``mcap``'s reader and from metadata.yaml, and laid out as ``ros2 bag info`` does: a leading
 blank line, labels padded to 19 columns, continuation lines indented 19 spaces, binary sizes,
-local-time dates with nine-digit nanoseconds.
+local-time dates with nine-digit nanoseconds; further service lines are indented 21 spaces.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ import shutil
 from typing import TYPE_CHECKING
 
 from tests.bag_record import support
+from tests.bag_record.conftest import NUMBERS
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -86,7 +87,11 @@ def expected_info(
         *[PAD + line for line in topic_lines[1:]],
         f"{'Service:':<19}{len(services)}",
         "Service information: " + service_lines[0],
-        *[PAD + line for line in service_lines[1:]],
+        # rosbag2 (rosbag2_py/src/rosbag2_py/format_bag_metadata.cpp) indents further service
+        # lines by 21, the width of "Service information: ", and ends each service line and
+        # then the whole text with a newline: a text that lists services ends with a blank line
+        *[" " * 21 + line for line in service_lines[1:]],
+        "",
     ]
     return lines
 
@@ -229,3 +234,33 @@ def test_info_of_an_unfinished_file_scans_it_to_the_same_numbers(
     assert finished.pop("unfinished") == []
     del scanned["bag_size"], finished["bag_size"]
     assert scanned == finished
+
+
+def test_info_verbose_shows_the_recorded_calls_and_each_topics_bytes(
+    service_bag: ServiceBag,
+) -> None:
+    """-v (rosbag2 Jazzy): each topic's and service's size contribution (the sum of its
+    serialized messages) and, per service, the requests and responses its events show."""
+    from mcap.reader import make_reader
+
+    result = support.rosl_run("bag", "info", "-v", str(service_bag.folder))
+    assert result.returncode == 0, result.stderr
+    sizes: dict[str, int] = {}
+    for path in support.bag_files(service_bag.folder):
+        with path.open("rb") as handle:
+            for _, channel, message in make_reader(handle).iter_messages():
+                sizes[channel.topic] = sizes.get(channel.topic, 0) + len(message.data)
+    calls = len(service_bag.calls)
+    lines = result.stdout.splitlines()
+    entries = [line.split(": ", 1)[1] if line.startswith(("Topic information", "Service inf"))
+               else line.strip() for line in lines]  # fmt: skip
+    assert (
+        "Service: /add_two_ints | Type: example_interfaces/srv/AddTwoInts | "
+        f"Request Count: {calls} | Response Count: {calls} | "
+        f"Size Contribution: {size_text(sizes['/add_two_ints/_service_event'])} | "
+        "Serialization Format: cdr"
+    ) in entries
+    assert (
+        f"Topic: /numbers | Type: std_msgs/msg/Int32 | Count: {len(NUMBERS)} | "
+        f"Size Contribution: {size_text(sizes['/numbers'])} | Serialization Format: cdr"
+    ) in entries

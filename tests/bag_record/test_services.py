@@ -46,11 +46,8 @@ def test_event_schemas_are_ros2idl_of_the_event_type(service_bag: ServiceBag) ->
     assert encoding == "ros2idl"
     assert text == full_idl(EVENT_TYPE)
     assert "IDL: service_msgs/msg/ServiceEventInfo\n" in text
-    meta = {
-        e["topic_metadata"]["name"]: e["topic_metadata"]
-        for e in support.metadata(service_bag.folder)["topics_with_message_count"]
-    }
-    assert meta[EVENT_TOPIC]["type_description_hash"] == support.rihs01(EVENT_TYPE, "ros2idl", text)
+    hashes = support.channel_hashes(service_bag.folder)
+    assert hashes[EVENT_TOPIC] == support.rihs01(EVENT_TYPE, "ros2idl", text)
 
 
 def test_requests_and_responses_are_sent_events_carrying_the_values(

@@ -1,6 +1,6 @@
 """The recorder's hold of messages on topics it cannot name yet is bounded in bytes and time.
 
-Unit tests drive the hold (``recorder._Pending``) with hand-made deliveries: the oldest go
+Unit tests drive the hold (``inbox.Pending``) with hand-made deliveries: the oldest go
 first, each buffer is counted once, a message bigger than the whole hold is refused, and the
 per-topic books only name topics that have messages held.
 
@@ -22,7 +22,8 @@ import uuid
 from typing import TYPE_CHECKING, Any
 
 from rosl.bag import recorder as recorder_module
-from rosl.bag.recorder import HELD_OVERHEAD, PENDING_BYTES, PENDING_MAX, Recorder
+from rosl.bag.inbox import HELD_OVERHEAD, Pending
+from rosl.bag.recorder import PENDING_BYTES, PENDING_MAX, Recorder
 from rosl.bus.header import Kind, topic_hash, type_hash
 from rosl.bus.wire import Delivery
 from tests.bag_record import support
@@ -58,7 +59,7 @@ def keys(hold: Any) -> list[tuple[int, int]]:
 
 def test_the_oldest_held_messages_are_dropped_first_when_the_bytes_run_out() -> None:
     cost = 1040 + HELD_OVERHEAD  # each payload keeps its whole 1040-byte datagram alive
-    hold = recorder_module._Pending(max_count=100, max_bytes=4 * cost)
+    hold = Pending(max_count=100, max_bytes=4 * cost)
     topics = [f"/t{i}" for i in range(6)]
     dropped = [hold.add(delivery(t, datagram(1000)), now=float(i)) for i, t in enumerate(topics)]
     assert dropped == [0, 0, 0, 0, 1, 1]
@@ -81,7 +82,7 @@ def test_the_oldest_held_messages_are_dropped_first_when_the_bytes_run_out() -> 
 
 
 def test_the_count_bound_also_drops_the_oldest() -> None:
-    hold = recorder_module._Pending(max_count=3, max_bytes=PENDING_BYTES)
+    hold = Pending(max_count=3, max_bytes=PENDING_BYTES)
     for i in range(5):
         hold.add(delivery("/same", bytearray(10), seq=i), now=float(i))
     assert [d.delivery.seq for d in hold.held] == [2, 3, 4]
@@ -92,7 +93,7 @@ def test_the_count_bound_also_drops_the_oldest() -> None:
 def test_messages_sharing_a_datagram_count_it_once_and_free_it_with_the_last() -> None:
     whole = bytes(60_000)
     view = memoryview(whole)
-    hold = recorder_module._Pending(max_count=100, max_bytes=PENDING_BYTES)
+    hold = Pending(max_count=100, max_bytes=PENDING_BYTES)
     for i in range(10):  # a coalesced datagram: ten records, one buffer
         hold.add(delivery("/batched", view[i * 6000 : (i + 1) * 6000], seq=i), now=0.0)
     assert hold.bytes == len(whole) + 10 * HELD_OVERHEAD
@@ -108,7 +109,7 @@ def test_messages_sharing_a_datagram_count_it_once_and_free_it_with_the_last() -
 
 
 def test_retry_keeps_the_order_and_expiry_empties_the_books() -> None:
-    hold = recorder_module._Pending(max_count=100, max_bytes=PENDING_BYTES)
+    hold = Pending(max_count=100, max_bytes=PENDING_BYTES)
     for i, topic in enumerate(["/a", "/b", "/a", "/c", "/b"]):
         hold.add(delivery(topic, datagram(100), seq=i), now=float(i))
     hold.retry(lambda d: d.topic == topic_hash("/c"))

@@ -50,7 +50,9 @@ def test_a_type_unknown_to_the_recorder_is_recorded_with_the_publishers_definiti
     empty = tmp_path / "recorder_cwd"
     empty.mkdir()
     folder = tmp_path / "custom_bag"
-    recorder = support.start_recorder(processes, "-a", "-o", str(folder), cwd=empty)
+    recorder = support.start_recorder(
+        processes, "-a", "-o", str(folder), "--distro", "jazzy", cwd=empty
+    )  # Jazzy's layout: metadata.yaml holds type hashes
     # the publisher does not wait for the recorder: its messages come while the recorder is
     # still asking for the type, and must be kept until the definition arrives; it stays up
     # long enough (the recorder's 3 s bound) to answer however loaded the machine is
@@ -96,7 +98,9 @@ def test_a_publisher_of_a_type_the_recorder_asked_for_sees_the_recorder_matched(
     empty = tmp_path / "recorder_cwd"
     empty.mkdir()
     folder = tmp_path / "custom_bag"
-    recorder = support.start_recorder(processes, "-a", "-o", str(folder), cwd=empty)
+    recorder = support.start_recorder(
+        processes, "-a", "-o", str(folder), "--distro", "jazzy", cwd=empty
+    )  # Jazzy's layout: metadata.yaml holds type hashes
     support.run_publisher(
         processes,
         {"node": "warmup", "publishers": [{"topic": "/warmup", "type": "std_msgs/msg/Int32"}],
@@ -125,7 +129,9 @@ def test_reindex_hashes_a_type_it_does_not_know_from_the_schema_in_the_file(
     empty = tmp_path / "recorder_cwd"
     empty.mkdir()
     folder = tmp_path / "custom_bag"
-    recorder = support.start_recorder(processes, "/reading", "-o", str(folder), cwd=empty)
+    recorder = support.start_recorder(
+        processes, "/reading", "-o", str(folder), "--distro", "jazzy", cwd=empty
+    )
     support.run_publisher(
         processes,
         {"node": "custom_talker", "publishers": [{"topic": "/reading", "type": TYPE}],

@@ -11,6 +11,7 @@ import pytest
 
 if TYPE_CHECKING:
     from collections.abc import Callable
+    from pathlib import Path
 
     from tests.launch.support import Rosl
 
@@ -62,16 +63,22 @@ def odom_x(inbox: Inbox) -> float:
 
 
 @pytest.mark.slow
-def test_a_paced_sim_publishes_its_topics_tf_tree_and_follows_cmd_vel(rosl: Rosl, ros: Any) -> None:
+def test_a_paced_sim_publishes_its_topics_tf_tree_and_follows_cmd_vel(
+    rosl: Rosl, ros: Any, tmp_path: Path
+) -> None:
     from geometry_msgs.msg import Twist  # noqa: F401 - the type must resolve in this process
     from nav_msgs.msg import Odometry
+    from rosbags.highlevel import AnyReader
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState, LaserScan
     from std_msgs.msg import String
     from tf2_msgs.msg import TFMessage
 
+    from rosl.bag.selection import RECORDER_NODE
+    from rosl.graph.records import SUBSCRIPTION
     from rosl.node.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
 
+    bag = tmp_path / "late_recording"
     sim = rosl.start("sim", "empty", "--real-time-factor", "2", "--headless")
     inbox = Inbox(ros, ros.Node("sim_probe"))
     for msg_type, topic in [(Clock, "/clock"), (Odometry, "/odom"), (JointState, "/joint_states")]:
@@ -95,6 +102,23 @@ def test_a_paced_sim_publishes_its_topics_tf_tree_and_follows_cmd_vel(rosl: Rosl
     }
     for child in ("base_link", "base_scan", "imu_link"):
         assert static[child] == TREE[child]
+
+    # so does a recorder started late: the bag holds the statics and the robot's description
+    recorder = rosl.start("bag", "record", "/tf_static", "/robot_description", "-o", str(bag))
+    graph = inbox.node.participant.graph
+
+    def recorded(topic: str) -> int:
+        found = [e for n, e in graph.endpoints(SUBSCRIPTION, topic) if n.name == RECORDER_NODE]
+        return int(found[0].stats.get("received", 0)) if found else 0
+
+    latched_topics = ("/tf_static", "/robot_description")
+    assert inbox.spin_until(lambda: all(recorded(t) >= 1 for t in latched_topics), 30.0), (
+        recorder.both()
+    )
+    assert recorder.interrupt() == 0, recorder.both()
+    with AnyReader([bag]) as reader:
+        kept = {c.topic: c.msgcount for c in reader.connections}
+    assert kept == {"/tf_static": 1, "/robot_description": 1}, kept
 
     odom = inbox.latest("/odom")
     assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_footprint")
