@@ -14,7 +14,8 @@ sent is kept as plain field values and compared with what each reader decodes:
   ``@foxglove/ros2idl-parser`` and ``@foxglove/rosmsg2-serialization`` — through
   ``foxglove_decode.mjs`` under node (npm packages installed by a session fixture into
   ``~/.cache/rosl-tests/foxglove-npm``), on the bag as recorded and on a zstd-compressed copy;
-- foxglove/mcap's validator (``mcap doctor``) where that binary is present.
+- foxglove/mcap's validator (``mcap doctor``), its release binary downloaded by the test setup
+  where it is missing.
 
 ``rosl bag filter``, ``rosl bag convert --compression-format zstd`` and ``rosl bag reindex`` (of
 a copy cut after its last chunk, without metadata.yaml) are read back with AnyReader, and every
@@ -64,6 +65,7 @@ NPM_PACKAGES = {  # what Foxglove and Lichtblick read MCAP + ROS 2 CDR with; exa
     "@foxglove/wasm-lz4": "1.0.2",
 }
 MCAP_CLI_CACHE = Path.home() / ".cache" / "rosl-tests" / "bin" / "mcap"
+MCAP_CLI_RELEASE = "releases/mcap-cli/v0.0.58"  # foxglove/mcap's Go CLI, a GitHub release
 
 EVENT_TOPIC = "/add_two_ints/_service_event"
 EVENT_TYPE = "example_interfaces/srv/AddTwoInts_Event"
@@ -524,16 +526,49 @@ def mcap_cli() -> str | None:
     return None
 
 
-@pytest.mark.parametrize("name", ["recorded", "converted"])
-def test_mcap_doctor_finds_no_problem(request: pytest.FixtureRequest, name: str) -> None:
+def download_mcap_cli() -> str | None:
+    """Fetch the pinned release binary into the test cache; why it cannot be, or None."""
+    import platform
+    import urllib.error
+    import urllib.request
+
+    build = {"x86_64": "linux-amd64", "aarch64": "linux-arm64"}.get(platform.machine())
+    if build is None or platform.system() != "Linux":
+        return f"no {MCAP_CLI_RELEASE} binary for {platform.system()} {platform.machine()}"
+    url = f"https://github.com/foxglove/mcap/releases/download/{MCAP_CLI_RELEASE}/mcap-{build}"
+    partial = MCAP_CLI_CACHE.with_suffix(".part")
+    try:
+        MCAP_CLI_CACHE.parent.mkdir(parents=True, exist_ok=True)
+        with urllib.request.urlopen(url, timeout=30) as response:
+            partial.write_bytes(response.read())
+        partial.chmod(0o755)
+        partial.replace(MCAP_CLI_CACHE)
+    except (OSError, urllib.error.URLError) as err:
+        partial.unlink(missing_ok=True)
+        return f"{url} cannot be downloaded here ({err}), and there is no Go toolchain to build it"
+    return None
+
+
+@pytest.fixture(scope="session")
+def mcap_doctor() -> str:
+    """foxglove/mcap's CLI, downloaded into the test cache where missing (or a skip, saying why)."""
     cli = mcap_cli()
     if cli is None:
-        pytest.skip(
-            "foxglove/mcap's `mcap` CLI is not here: it is published only as GitHub release "
-            "binaries, which this machine cannot download (only the PyPI, npm and Debian "
-            "registries are reachable), and there is no Go toolchain to build it; put the binary "
-            f"at {MCAP_CLI_CACHE} or name it in ROSL_MCAP_CLI to run this check"
-        )
+        reason = download_mcap_cli()
+        cli = mcap_cli()
+        if cli is None:
+            pytest.skip(
+                f"foxglove/mcap's `mcap` CLI is not here: {reason or 'the download does not run'}"
+                f"; put the binary at {MCAP_CLI_CACHE} or name it in ROSL_MCAP_CLI"
+            )
+    return cli
+
+
+@pytest.mark.parametrize("name", ["recorded", "converted"])
+def test_mcap_doctor_finds_no_problem(
+    request: pytest.FixtureRequest, mcap_doctor: str, name: str
+) -> None:
+    cli = mcap_doctor
     for path in support.bag_files(bag(request, name)):
         result = subprocess.run([cli, "doctor", str(path)], capture_output=True, text=True,
                                 timeout=60, check=False)  # fmt: skip
