@@ -34,16 +34,21 @@ class Intake:
         self._lock = threading.Lock()
         self._arrived = threading.Event()
         self._stopping = False
+        self._failure: BaseException | None = None  # what ended the thread: take() raises it
         self._thread = threading.Thread(target=self._run, name="rosl-recorder-intake", daemon=True)
         self._thread.start()
 
     def _run(self) -> None:
-        while not self._stopping:
-            if self._bytes > INBOX_BYTES:  # the writer is far behind: let the socket fill
-                self._arrived.set()
-                time.sleep(0.01)
-                continue
-            self._participant.poll(0.05, sink=self._put)
+        try:
+            while not self._stopping and not self._participant.closed:
+                if self._bytes > INBOX_BYTES:  # the writer is far behind: let the socket fill
+                    self._arrived.set()
+                    time.sleep(0.01)
+                    continue
+                self._participant.poll(0.05, sink=self._put)
+        except BaseException as err:  # told to the recording thread, not lost with this one
+            self._failure = err
+            self._arrived.set()
 
     def _put(self, delivery: Delivery) -> None:
         with self._lock:
@@ -51,13 +56,24 @@ class Intake:
             self._bytes += len(delivery.payload) + HELD_OVERHEAD
         self._arrived.set()
 
+    @property
+    def queued(self) -> int:
+        """How many deliveries wait to be taken."""
+        return len(self._queue)
+
     def wait(self, timeout: float) -> None:
         """Wait (at most ``timeout``) until something is queued."""
         if not self._queue:
             self._arrived.wait(timeout)
 
     def take(self) -> list[Delivery]:
-        """Everything queued so far, oldest first."""
+        """Everything queued so far, oldest first.
+
+        Raises:
+            BaseException: what ended the receiving thread (once what came before is taken).
+        """
+        if self._failure is not None and not self._queue:
+            raise self._failure
         with self._lock:
             taken = list(self._queue)
             self._queue.clear()
@@ -66,9 +82,9 @@ class Intake:
         return taken
 
     def stop(self) -> None:
-        """Stop receiving (what is queued stays for :meth:`take`)."""
+        """Stop receiving and wait for the thread (what is queued stays for :meth:`take`)."""
         self._stopping = True
-        self._thread.join(timeout=5.0)
+        self._thread.join()  # it polls in steps of 50 ms: this ends
 
 
 class Held(NamedTuple):

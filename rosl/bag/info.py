@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 from rosl.bag.errors import BagError
-from rosl.bag.reader import has_summary, stream_records
+from rosl.bag.reader import damaged, has_summary, stream_records
 
 if TYPE_CHECKING:
     from collections.abc import Collection, Iterable
@@ -78,8 +78,6 @@ def extent(files: Iterable[Path]) -> Extent:
     Raises:
         BagError: a file that cannot be read.
     """
-    from mcap.exceptions import McapError
-
     from rosl.bag import sqlite
 
     total = Extent()
@@ -94,8 +92,10 @@ def extent(files: Iterable[Path]) -> Extent:
                 if found is None:
                     handle.seek(0)
                     found = _from_records(handle)
-        except (McapError, OSError, ValueError, KeyError) as err:
-            raise BagError(f"cannot read {path}: {err}") from None
+        except OSError as err:
+            raise BagError(f"cannot read {path}: {err.strerror}") from None
+        except Exception as err:  # the mcap library's, zstd's or lz4's: a damaged file
+            raise BagError(damaged(path, err)) from None
         total.merge(found)
     return total
 

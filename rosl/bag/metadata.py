@@ -49,10 +49,15 @@ _PROFILE_KEYS = (
 def distro(given: str | None = None) -> str:
     """The distro a new bag is labelled with: ``given``, else ``ROS_DISTRO``, else humble.
 
+    ``ROS_DISTRO`` naming a distro without a layout here (an older one) gives humble's.
+
     Raises:
-        BagError: a distro whose rosbag2 layout is not known here.
+        BagError: a ``given`` distro whose rosbag2 layout is not known here.
     """
-    name = (given or os.environ.get("ROS_DISTRO") or DISTRO).strip().lower()
+    if not given:  # an environment set up for another distro (foxy, noetic) writes humble's
+        name = os.environ.get("ROS_DISTRO", "").strip().lower()
+        return name if name in VERSIONS else DISTRO
+    name = given.strip().lower()
     if name not in VERSIONS:
         raise BagError(f"unknown ROS distro '{name}' (choose one of {', '.join(sorted(VERSIONS))})")
     return name
@@ -108,10 +113,12 @@ def normalize_profile(profile: Mapping[str, Any]) -> dict[str, Any]:
             names = _POLICIES[key]
             if isinstance(value, int) and not isinstance(value, bool):
                 value = names[value] if 0 <= value < len(names) else "unknown"
+            elif value is None:
+                value = "system_default"
             else:
-                value = str(value or "system_default").lower()
-        elif key == "depth":
-            value = int(value or 0)
+                value = str(value).lower() if str(value).lower() in names else "unknown"
+        elif key == "depth":  # a bag written by another tool may hold anything here
+            value = value if isinstance(value, int) and not isinstance(value, bool) else 0
         elif key == "avoid_ros_namespace_conventions":
             value = bool(value)
         elif not _duration(value):  # missing, or Foxy's "infinite" (rosbag2 reads it so too)
@@ -124,8 +131,7 @@ def _duration(value: Any) -> bool:
     """Whether a profile's duration is a finite ``{sec, nsec}`` or today's infinite."""
     return (
         isinstance(value, dict)
-        and "sec" in value
-        and "nsec" in value
+        and all(isinstance(value.get(k), int) for k in ("sec", "nsec"))
         and (value["sec"], value["nsec"]) not in _FOXY_INFINITE
     )
 
@@ -145,7 +151,9 @@ def qos_text(profiles: list[dict[str, Any]], version: int) -> str:
     """The YAML text of a topic's profiles, as MCAP channels (and version < 9 files) hold it."""
     if not profiles:
         return ""
-    return yaml.safe_dump([render_profile(p, version) for p in profiles], sort_keys=False)
+    return yaml.safe_dump(
+        [render_profile(p, version) for p in profiles], sort_keys=False, width=_NO_WRAP
+    )
 
 
 def offered_qos(channel_metadata: Mapping[str, str]) -> list[dict[str, Any]]:
@@ -246,14 +254,29 @@ def write(
     body = information(topics, files, custom=custom, ros_distro=ros_distro, storage=storage)
     path = folder / "metadata.yaml"
     temporary = path.with_suffix(".yaml.tmp")
+    text = yaml.safe_dump({"rosbag2_bagfile_information": body}, sort_keys=False, width=_NO_WRAP)
     try:
-        temporary.write_text(yaml.safe_dump({"rosbag2_bagfile_information": body}, sort_keys=False))
+        with temporary.open("w", encoding="utf-8") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())  # on disk before it replaces the old one
         temporary.replace(path)
+        sync_folder(folder)
     except OSError as err:
         with contextlib.suppress(OSError):
             temporary.unlink(missing_ok=True)
         raise BagError(f"cannot write {path}: {err.strerror}") from None
     return path
+
+
+def sync_folder(folder: Path) -> None:
+    """Make a rename in ``folder`` survive a crash: fsync the folder (where the system can)."""
+    with contextlib.suppress(OSError):
+        descriptor = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)
+        finally:
+            os.close(descriptor)
 
 
 def labelled(info: Mapping[str, Any] | None) -> str:

@@ -61,7 +61,8 @@ def bag_files(target: Path) -> tuple[list[Path], dict[str, Any] | None]:
             )
     else:
         info = None
-        files = split_order([*target.glob("*.mcap"), *target.glob(f"*{sqlite.SUFFIX}")])
+        found = [*target.glob("*.mcap"), *target.glob(f"*{sqlite.SUFFIX}")]
+        files = split_order(p for p in found if p.stat().st_size)  # an empty one holds nothing
         if not files:
             raise BagError(f"'{target}' holds no metadata.yaml and no .mcap or .db3 files")
     for path in files:
@@ -125,20 +126,42 @@ def has_summary(path: Path) -> bool:
 
 
 def iter_file(path: Path, topics: set[str] | None = None) -> Iterator[BagMessage]:
-    """Messages of one MCAP or ``.db3`` file in log-time order (stream order if unfinished)."""
-    from mcap.exceptions import McapError
+    """Messages of one MCAP or ``.db3`` file in log-time order (stream order if unfinished).
 
+    Raises:
+        BagError: a chunk that cannot be read (damaged, not decompressible) after the first
+            messages: one line that names the file and the repair.
+    """
     if sqlite.is_db3(path):
         yield from sqlite.iter_messages(path, topics)
         return
     with path.open("rb") as handle:
+        if not has_summary(path):  # unfinished: up to its torn tail
+            yield from iter_records(handle, topics)
+            return
+        yielded = 0
         try:
-            if has_summary(path):
-                yield from _iter_indexed(handle, topics)
-                return
-        except McapError:
-            handle.seek(0)
-        yield from iter_records(handle, topics)
+            for message in _iter_indexed(handle, topics):
+                yielded += 1
+                yield message
+            return
+        except Exception as err:  # the mcap library's, zstd's or lz4's: a damaged file
+            if yielded:  # read again from the start, they would come twice
+                raise BagError(damaged(path, err)) from None
+        handle.seek(0)  # a summary that does not hold: read it record by record, to its end
+        failures: list[Exception] = []
+        yield from iter_records(handle, topics, failures)
+        if failures:  # a finished file ends cleanly: this one is damaged
+            raise BagError(damaged(path, failures[0]))
+
+
+def damaged(path: Path, err: BaseException) -> str:
+    """The one line for a file that cannot be read on: what failed, and the repair."""
+    reason = (str(err).splitlines() or [type(err).__name__])[0][:120]
+    return (
+        f"cannot read {path}: {reason} (a damaged chunk? `rosl bag reindex {path.parent} "
+        "--keep-corrupt` rewrites it with what can be read)"
+    )
 
 
 def _iter_indexed(handle: BinaryIO, topics: set[str] | None) -> Iterator[BagMessage]:
@@ -159,8 +182,11 @@ def _iter_indexed(handle: BinaryIO, topics: set[str] | None) -> Iterator[BagMess
         )
 
 
-def stream_records(handle: BinaryIO) -> Iterator[Any]:
-    """The records of an MCAP stream in file order (chunks opened), up to a torn tail."""
+def stream_records(handle: BinaryIO, failures: list[Exception] | None = None) -> Iterator[Any]:
+    """The records of an MCAP stream in file order (chunks opened), up to a torn tail.
+
+    What ended the stream early (a torn tail, a damaged chunk) goes to ``failures``.
+    """
     from mcap.stream_reader import StreamReader
 
     records = StreamReader(handle, skip_magic=False, emit_chunks=False).records
@@ -169,19 +195,26 @@ def stream_records(handle: BinaryIO) -> Iterator[Any]:
             record = next(records)
         except StopIteration:
             return
-        except Exception:  # the torn end of an unfinished file: whatever the library raises
+        except Exception as err:  # whatever the library raises on what it cannot read
+            if failures is not None:
+                failures.append(err)
             return
         yield record
 
 
-def iter_records(handle: BinaryIO, topics: set[str] | None = None) -> Iterator[BagMessage]:
-    """Messages of an MCAP stream read record by record, stopping at a torn tail."""
+def iter_records(
+    handle: BinaryIO, topics: set[str] | None = None, failures: list[Exception] | None = None
+) -> Iterator[BagMessage]:
+    """Messages of an MCAP stream read record by record, stopping at a torn tail.
+
+    What ended the stream early goes to ``failures`` (see :func:`stream_records`).
+    """
     from mcap.records import Channel as McapChannel
     from mcap.records import Message, Schema
 
     schemas: dict[int, Any] = {}
     channels: dict[int, Any] = {}
-    for record in stream_records(handle):
+    for record in stream_records(handle, failures):
         if isinstance(record, Schema):
             schemas[record.id] = record
         elif isinstance(record, McapChannel):

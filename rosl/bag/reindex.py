@@ -105,11 +105,22 @@ def reindex(folder: Path, keep_corrupt: bool = False) -> list[str]:
     if not folder.is_dir():
         raise BagError(f"'{folder}' is not a recording folder")
     files = split_order(folder.glob("*.mcap"))
+    stored = sorted(p.name for p in folder.glob("*.db3"))
+    if stored:  # SQLite commits whole transactions: a .db3 is never left torn
+        raise BagError(
+            f"'{folder}' holds rosbag2 sqlite3 files ({', '.join(stored)}): they need no "
+            "reindex; reindex repairs folders of .mcap files"
+        )
     if not files:
         raise BagError(f"'{folder}' holds no .mcap files to reindex")
+    empty = [p for p in files if p.stat().st_size == 0]  # killed before it wrote a byte
+    files = [p for p in files if p not in empty]
+    if not files:
+        raise BagError(f"'{folder}' holds only empty .mcap files: nothing to reindex")
     for path in files:  # before anything is rewritten
         check_magic(path)
     old = _old_information(folder)
+    custom = _custom(old)
     previous: Previous = {
         e["topic_metadata"]["name"]: e["topic_metadata"]
         for e in (old or {}).get("topics_with_message_count") or []
@@ -128,17 +139,39 @@ def reindex(folder: Path, keep_corrupt: bool = False) -> list[str]:
     label = metadata.labelled(old) if old else metadata.labelled({"ros_distro": _first(distros)})
     for path in files:
         if path not in lines:
-            found, lines[path] = _rewrite(path, previous, label, keep_corrupt)
+            found, lines[path] = _rewrite(path, previous, label, keep_corrupt, custom)
             if found is not None:
                 tallies[path] = found
-    said = [line for path in files for line in lines[path]]
+    said = [f"{p.name}: empty (its recorder stopped before writing); left out" for p in empty]
+    said += [line for path in files for line in lines[path]]
     if len(tallies) == len(files) and _matches(old, files, list(tallies.values())):
         return [*said, "metadata.yaml: matches the files; nothing was changed"]
     topics = _topics([tallies[p] for p in files if p in tallies], previous)
     infos = [tallies[p].info for p in files if p in tallies]
-    metadata.write(folder, topics, infos, ros_distro=label)
+    listed = set((old or {}).get("relative_file_paths") or [])
+    if listed - {info.path for info in infos}:  # a file it named is left out: keep it to read
+        _replace_aside(folder / "metadata.yaml")
+        said.append("metadata.yaml: the old one names files left out; kept as metadata.yaml.orig")
+    metadata.write(folder, topics, infos, custom, ros_distro=label)
     total = sum(t.count for t in topics)
     return [*said, f"metadata.yaml: {total} messages on {len(topics)} topics"]
+
+
+def _custom(old: dict[str, Any] | None) -> dict[str, str]:
+    """The old metadata's ``custom_data`` (kept, as filter and convert keep it)."""
+    custom = (old or {}).get("custom_data") or {}
+    return {str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {}
+
+
+def _replace_aside(path: Path) -> None:
+    """Copy ``path`` to ``<path>.orig`` (on disk before anything replaces it)."""
+    aside = path.with_name(path.name + ".orig")
+    try:
+        shutil.copyfile(path, aside)
+        with aside.open("rb") as handle:
+            os.fsync(handle.fileno())
+    except OSError as err:
+        raise BagError(f"cannot keep {path} as {aside.name}: {err.strerror}") from None
 
 
 def _first(names: list[str]) -> str:
@@ -159,7 +192,7 @@ def _records(path: Path, scan: salvage.Scan, keep_bad: bool = False) -> Iterator
 
 
 def _rewrite(
-    path: Path, previous: Previous, label: str, keep_corrupt: bool
+    path: Path, previous: Previous, label: str, keep_corrupt: bool, custom: dict[str, str]
 ) -> tuple[_Tally | None, list[str]]:
     """Rewrite one file whole; its tally (None: left as it was) and the lines that say so.
 
@@ -181,12 +214,22 @@ def _rewrite(
                 tally.take(record)
             if tally.info.count:
                 topics = list(tally.topics.values())
-                bag.finish(metadata.information(topics, [tally.info], ros_distro=label), label)
+                information = metadata.information(
+                    topics, [tally.info], custom=custom, ros_distro=label
+                )
+                bag.finish(information, label)
         finally:
             bag.abandon()  # closed as it is, unless finished
-    except (BagError, OSError) as err:
+    except BaseException as err:
         _remove(temporary)
-        reason = str(err) if isinstance(err, BagError) else f"cannot read {path}: {err.strerror}"
+        if not isinstance(err, Exception):
+            raise  # Ctrl-C: the original is untouched, the partial copy gone
+        if isinstance(err, BagError):
+            reason = str(err)
+        elif isinstance(err, OSError):
+            reason = f"cannot read {path}: {err.strerror}"
+        else:  # the file holds something no reader foresaw
+            reason = f"cannot rewrite {path}: {type(err).__name__}: {err}"
         raise BagError(f"{reason} ({path.name} was left as it was)") from None
     lost = _lost(path, scan, tally, keep_corrupt)
     lines = [f"{path.name}: {text}" for text in lost]
@@ -249,18 +292,15 @@ def _replace(path: Path, temporary: Path, keep: bool) -> Path | None:
                 os.link(path, aside)  # the original stays where it is until it is replaced
             except OSError:
                 shutil.copy2(path, aside)  # a file system without hard links
+                with aside.open("rb") as handle:
+                    os.fsync(handle.fileno())  # the copy on disk before the original goes
         temporary.replace(path)
     except OSError as err:
         _remove(temporary)
         raise BagError(
             f"cannot replace {path}: {err.strerror or type(err).__name__} (it was left as it was)"
         ) from None
-    with contextlib.suppress(OSError):  # the renames on disk too
-        descriptor = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(descriptor)
-        finally:
-            os.close(descriptor)
+    metadata.sync_folder(path.parent)  # the renames on disk too
     return aside
 
 

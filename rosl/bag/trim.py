@@ -9,6 +9,7 @@ changes the chunk compression. :func:`scan` (the bag's channel table) is shared 
 
 from __future__ import annotations
 
+import contextlib
 import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, BinaryIO
@@ -194,8 +195,8 @@ def copy(
 ) -> CopyResult:
     """Write the selected messages of ``source`` to a new rosbag2 folder ``output``.
 
-    Every selected topic gets its channel and its entry in ``metadata.yaml``, also when no
-    message of it falls in the window.
+    Every selected topic of the source's channels gets its channel and its entry in
+    ``metadata.yaml``, also when no message of it falls in the window.
 
     Args:
         source: a bag folder or MCAP file.
@@ -212,7 +213,6 @@ def copy(
         BagError: unreadable source, bad pattern or window, output not writable.
     """
     found = scan(source)
-    refuse_foreign_encodings(found)
     label = metadata.distro(ros_distro) if ros_distro else metadata.labelled(found.info)
     pattern = _pattern(exclude)
     wanted = sorted(
@@ -220,6 +220,7 @@ def copy(
         for name in found.channels
         if (topics is None or name in topics) and not (pattern and pattern.search(name))
     )
+    refuse_foreign_encodings(found, set(wanted))
     first = found.start_ns
     if start is not None or end is not None:  # the first message held, not what Statistics say
         first = extent(found.files).start_ns
@@ -238,16 +239,20 @@ def copy(
     result.warnings = [unfinished_warning(p) for p in found.unfinished]
     result.warnings += [f"warning: topic {t} is not in {source}" for t in topics or () if
                         t not in found.channels]  # fmt: skip
-    _prepare(source, output)
+    created = _prepare(source, output)
     infos = _topic_infos(found, wanted)
-    out: BagFile | sqlite.Db3File = (
-        sqlite.Db3File(output / f"{output.name}_0{sqlite.SUFFIX}", label)
-        if storage == sqlite.STORAGE
-        else BagFile(
-            output / f"{output.name}_0.mcap", compression=chosen, library="rosl bag filter",
-            version=metadata.VERSIONS[label],
-        )
-    )  # fmt: skip
+    try:
+        out: BagFile | sqlite.Db3File = (
+            sqlite.Db3File(output / f"{output.name}_0{sqlite.SUFFIX}", label)
+            if storage == sqlite.STORAGE
+            else BagFile(
+                output / f"{output.name}_0.mcap", compression=chosen, library="rosl bag filter",
+                version=metadata.VERSIONS[label],
+            )
+        )  # fmt: skip
+    except BaseException:
+        _unprepare(output, created)
+        raise
     try:
         ids = {
             info.name: out.channel(
@@ -272,8 +277,10 @@ def copy(
             ),
             label,
         )
-    except BaseException:
+    except BaseException:  # nothing half-written is left: the folder is as it was
         out.abandon()
+        out.path.unlink(missing_ok=True)
+        _unprepare(output, created)
         raise
     metadata.write(output, infos, [out.info], custom, ros_distro=label, storage=storage)
     return result
@@ -288,15 +295,26 @@ def _pattern(exclude: str | None) -> re.Pattern[str] | None:
         raise BagError(f"--exclude '{exclude}' is not a regular expression: {err}") from None
 
 
-def _prepare(source: Path, output: Path) -> None:
-    if output.resolve() == source.resolve() or source.resolve().is_relative_to(output.resolve()):
+def _prepare(source: Path, output: Path) -> bool:
+    """Make the (empty) output folder; whether it was made here."""
+    inside = source.is_dir() and output.resolve().is_relative_to(source.resolve())
+    if inside or source.resolve().is_relative_to(output.resolve()):
         raise BagError(f"the output folder '{output}' would overwrite the input '{source}'")
     if output.exists() and (not output.is_dir() or any(output.iterdir())):
         raise BagError(f"Output folder '{output}' already exists and is not empty")
+    created = not output.exists()
     try:
         output.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise BagError(f"cannot create '{output}': {err.strerror}") from None
+    return created
+
+
+def _unprepare(output: Path, created: bool) -> None:
+    """Remove the output folder again when it was made here (and is empty)."""
+    if created:
+        with contextlib.suppress(OSError):
+            output.rmdir()
 
 
 def _topic_infos(found: Scan, names: list[str]) -> list[metadata.TopicInfo]:

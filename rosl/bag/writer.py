@@ -82,6 +82,8 @@ class BagFile:
         self._writer = Writer(self._handle, chunk_size=chunk_size, compression=kinds[compression])
         with self._failing("write"):
             self._writer.start(profile="ros2", library=library)
+            self._handle.flush()  # on disk at once: a file killed now is still MCAP
+            os.fsync(self._handle.fileno())
 
     # --- channels and messages ---------------------------------------------------------------
 

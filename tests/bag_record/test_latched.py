@@ -49,16 +49,20 @@ def test_a_late_recorder_records_the_latched_history_once_and_lists_the_silent_t
     assert wait_until(lambda: recorder_stat("/static", "received") == 3, timeout=30.0), (
         graph.endpoints(SUBSCRIPTION, "/static")
     )
-    (subscription,) = [e for n, e in graph.endpoints(SUBSCRIPTION, "/static")]
+    ((owner, subscription),) = graph.endpoints(SUBSCRIPTION, "/static")
     assert subscription.qos["durability"] == "TRANSIENT_LOCAL"
     latched.publish(String(data="static 5"))  # live, and in the history from now on
     assert wait_until(lambda: recorder_stat("/static", "received") == 4, timeout=30.0)
+    # the history again (as when a request crosses live messages): all recorded already
+    latched.replay((owner.process, subscription.endpoint))
+    latched.publish(String(data="static 6"))  # sent after the replayed copies
+    assert wait_until(lambda: recorder_stat("/static", "received") == 5, timeout=30.0)
     support.stop_recorder(recorder, signal.SIGINT)
 
     found = support.by_topic(support.read_anyreader(folder))
-    assert [m.fields["data"] for m in found["/static"]] == [f"static {i}" for i in (2, 3, 4, 5)]
+    assert [m.fields["data"] for m in found["/static"]] == [f"static {i}" for i in range(2, 7)]
     assert "/plain" not in found
     counts = support.topic_counts(folder)
-    assert (counts["/static"], counts["/plain"]) == (4, 0)
+    assert (counts["/static"], counts["/plain"]) == (5, 0)
     channels = {t for f in support.read_mcap(folder) for t in f.channels}
     assert channels == set(counts)  # every listed topic has its channel, with messages or not
