@@ -4,15 +4,17 @@ A launch file with N `tutorial_pkg my_publisher` nodes (names bench_<run>_<i>) i
 a temporary folder. This process watches the graph with its own rosl participant (event driven:
 it wakes on every graph change). Rows, median of --runs runs:
 
-  rosl launch           `rosl launch FILE`: from Popen until all N nodes are visible; then
-                        SIGINT to the launcher until it has exited and every child pid is gone
+  rosl launch           `rosl launch FILE.launch.py`: from Popen until all N nodes are visible;
+                        then SIGINT to the launcher until it has exited and every child pid is
+                        gone
+  rosl launch (xml)     the same N nodes from `FILE.launch.xml` (ROS 2's XML format)
   rosl run x N          the baseline: N `python -m rosl run tutorial_pkg my_publisher --ros-args
                         -r __node:=NAME` started in parallel (each execs a second interpreter);
                         stop = SIGINT to each, until all have exited
   entry x N             for reference, the exact command lines the launcher starts
                         (`python -m rosl.pkg.entry ...`, one interpreter each), in parallel
 
-Ratios are launch / (rosl run x N), measured in the same run.
+Ratios are row / (rosl run x N), measured in the same run.
 
     python bench/launch_timing.py [--nodes 10] [--runs 5]
 """
@@ -45,6 +47,23 @@ def generate_launch_description():
         ]
     )
 """
+
+XML_LAUNCH_FILE = """<launch>
+{nodes}
+</launch>
+"""
+XML_NODE = '  <node pkg="tutorial_pkg" exec="my_publisher" name="{name}"/>'
+
+
+def write_launch_file(folder: Path, names: list[str], xml: bool) -> Path:
+    if xml:
+        path = folder / f"{names[0]}.launch.xml"
+        nodes = "\n".join(XML_NODE.format(name=name) for name in names)
+        path.write_text(XML_LAUNCH_FILE.format(nodes=nodes))
+    else:
+        path = folder / f"{names[0]}.launch.py"
+        path.write_text(LAUNCH_FILE.format(names=names))
+    return path
 
 
 def descendants(pid: int) -> list[int]:
@@ -79,9 +98,10 @@ class Watcher:
         self.participant.close()
 
 
-def run_launch(watcher: Watcher, folder: Path, names: list[str]) -> tuple[float, float]:
-    path = folder / f"{names[0]}.launch.py"
-    path.write_text(LAUNCH_FILE.format(names=names))
+def run_launch(
+    watcher: Watcher, folder: Path, names: list[str], xml: bool = False
+) -> tuple[float, float]:
+    path = write_launch_file(folder, names, xml)
     log = open(folder / "launch.log", "w")  # noqa: SIM115
     pids: list[int] = []
     start = time.perf_counter()
@@ -112,8 +132,10 @@ def run_launch(watcher: Watcher, folder: Path, names: list[str]) -> tuple[float,
         log.close()
 
 
-def run_parallel(watcher: Watcher, commands: list[list[str]], names: list[str]) -> tuple:
-    children: list[subprocess.Popen] = []
+def run_parallel(
+    watcher: Watcher, commands: list[list[str]], names: list[str]
+) -> tuple[float, float]:
+    children: list[subprocess.Popen[bytes]] = []
     env = bench_env(DOMAIN)
     start = time.perf_counter()
     try:
@@ -160,7 +182,8 @@ def main() -> None:
     parser.add_argument("--nodes", type=int, default=10)
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
-    kinds = ("rosl launch", "rosl run x N", "entry x N")
+    kinds = ("rosl launch", "rosl launch (xml)", "rosl run x N", "entry x N")
+    tags = {"rosl launch": "l", "rosl launch (xml)": "x", "rosl run x N": "r", "entry x N": "e"}
     results: dict[str, list[tuple[float, float]]] = {kind: [] for kind in kinds}
     watcher = Watcher()
     try:
@@ -168,11 +191,10 @@ def main() -> None:
             folder = Path(tmp)
             for run in range(args.runs + 1):  # round 0 warms the byte-code cache
                 for kind in kinds:
-                    tag = {"rosl launch": "l", "rosl run x N": "r", "entry x N": "e"}[kind]
-                    names = [f"bench_{tag}{run}_{i}" for i in range(args.nodes)]
+                    names = [f"bench_{tags[kind]}{run}_{i}" for i in range(args.nodes)]
                     time.sleep(0.5)  # let the previous processes finish exiting
-                    if kind == "rosl launch":
-                        measured = run_launch(watcher, folder, names)
+                    if kind.startswith("rosl launch"):
+                        measured = run_launch(watcher, folder, names, xml=kind.endswith("(xml)"))
                     elif kind == "rosl run x N":
                         measured = run_parallel(watcher, run_commands(names), names)
                     else:
@@ -185,11 +207,11 @@ def main() -> None:
     base_up = statistics.median(up for up, _ in results["rosl run x N"])
     base_down = statistics.median(down for _, down in results["rosl run x N"])
     print(f"{args.nodes} nodes (tutorial_pkg my_publisher), median of {args.runs} runs")
-    print(f"{'':14} {'all visible s':>13} {'ratio':>6} {'SIGINT->gone s':>15} {'ratio':>6}")
+    print(f"{'':17} {'all visible s':>13} {'ratio':>6} {'SIGINT->gone s':>15} {'ratio':>6}")
     for kind in kinds:
         up = statistics.median(u for u, _ in results[kind])
         down = statistics.median(d for _, d in results[kind])
-        print(f"{kind:14} {up:>13.3f} {up / base_up:>6.2f} {down:>15.3f} {down / base_down:>6.2f}")
+        print(f"{kind:17} {up:>13.3f} {up / base_up:>6.2f} {down:>15.3f} {down / base_down:>6.2f}")
     print("ratio = this row / `rosl run x N` (the baseline) in the same run")
 
 

@@ -20,6 +20,19 @@ module as a pytest plugin (the ``pytest11`` entry point ``rosl.testing``), so th
 ``-p rosl.testing`` (which, like ``pytest_plugins = ["rosl.testing"]``, still works). By
 default the comparison leaves out ``/rosout``, ``/parameter_events``, ``/clock`` and service
 events, and ignores ``header.stamp`` fields at any depth — they change from run to run.
+
+In a launch test (``rosl launch_test`` or pytest), the ``Record`` launch action records the
+launch itself and a post-shutdown test compares the bag::
+
+    @pytest.mark.launch_test
+    def generate_test_description():
+        record = Record()  # the bag of this run, in a fresh temporary folder
+        return LaunchDescription([record, Node(...), ReadyToTest()]), {"bag": record.output}
+
+    @launch_testing.post_shutdown_test()
+    class TestRecording(unittest.TestCase):
+        def test_run_matches_the_golden_log(self, bag):
+            assert_matches_golden(bag, GOLDEN, topics=["/chatter"])
 """
 
 from __future__ import annotations
@@ -31,7 +44,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import IO, TYPE_CHECKING
+from typing import IO, TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -39,12 +52,23 @@ if TYPE_CHECKING:
     import pytest
 
     from rosl.bag.diff import DiffResult
+    from rosl.launch.runner import Record
 
+__unittest = True  # a launch test's report shows the user's line, not the comparison's
 FLAG = "--rosl-regenerate-golden"
 ENV = "ROSL_REGENERATE_GOLDEN"
 DEFAULT_EXCLUDE = r"^/(rosout|parameter_events|clock)$|/_service_event$"
 DEFAULT_IGNORE = ("header.stamp", "*.header.stamp")
 _flag_given = False
+
+
+def __getattr__(name: str) -> Any:
+    """``Record`` (a launch action), imported on first use: this module is a pytest plugin."""
+    if name == "Record":
+        from rosl.launch.runner import Record
+
+        return Record
+    raise AttributeError(f"module 'rosl.testing' has no attribute '{name}'")
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
@@ -215,7 +239,7 @@ def assert_matches_golden(
     if not result.matched:
         raise AssertionError(
             f"{new_bag} does not match the golden bag {golden_bag}:\n{result.text()}"
-            f"(if the change is intended, regenerate with `pytest {FLAG}`)"
+            f"(if the change is intended, regenerate with `pytest {FLAG}` or {ENV}=1)"
         )
     return result
 
@@ -241,3 +265,12 @@ def replace_golden(new_bag: Path, golden_bag: Path) -> None:
     if golden_bag.exists():
         shutil.rmtree(golden_bag) if golden_bag.is_dir() else golden_bag.unlink()
     staging.rename(golden_bag)
+
+
+__all__ = [
+    "Record",
+    "assert_matches_golden",
+    "record_launch",
+    "regenerating",
+    "replace_golden",
+]

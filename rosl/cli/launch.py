@@ -1,4 +1,8 @@
-"""``rosl launch PKG FILE [name:=value ...]`` or ``rosl launch PATH [name:=value ...]``."""
+"""``rosl launch PKG FILE [name:=value ...]`` or ``rosl launch PATH [name:=value ...]``.
+
+FILE is a Python (``*.launch.py``), XML (``*.launch.xml``) or YAML (``*.launch.yaml``) launch
+file; ``--show-args`` and ``--print`` read all three the same way.
+"""
 
 from __future__ import annotations
 
@@ -55,7 +59,7 @@ def command(
     serve_port: int,
     domain_id: int | None,
 ) -> int:
-    """Run a launch file: `rosl launch tutorial_pkg my_launch.py` or `rosl launch ./x.launch.py`."""
+    """Run a launch file (Python, XML or YAML): `rosl launch tutorial_pkg my_launch.py`."""
     export_domain(domain_id)
     if (bridge or serve) and not (show_args or print_plan):
         from rosl.cli.companion import companions
@@ -93,4 +97,9 @@ def _launch(
         import datetime
 
         folder = Path(record or datetime.datetime.now().strftime("launch_%Y_%m_%d-%H_%M_%S"))
-    return runner.launch(path, arguments, record=folder)
+    code = runner.launch(path, arguments, record=folder)
+    if code == 130:  # a Ctrl-C ended the loading: it may have left the launch file's code
+        from rosl.pkg import interrupts
+
+        interrupts.caught()  # (else CPython would end the process by SIGINT: status -2)
+    return code

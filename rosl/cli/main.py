@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "graph": ("rosl.cli.graph", "The node/topic graph as DOT, Mermaid or text (rqt_graph)"),
     "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),
     "launch": ("rosl.cli.launch", "Run a launch file"),
+    "launch_test": ("rosl.cli.launch_test", "Run a launch test (ROS 2's launch_test)"),
     "lifecycle": ("rosl.cli.planned:lifecycle", "Lifecycle nodes: not in rosl yet"),
     "multicast": ("rosl.cli.multicast", "Various multicast related sub-commands"),
     "node": ("rosl.cli.node", "Various node related sub-commands"),

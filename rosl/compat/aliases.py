@@ -21,6 +21,8 @@ ALIASES: dict[str, str] = {
     "rclpy": "rosl.compat.rclpy",
     "launch": "rosl.compat.launch",
     "launch_ros": "rosl.compat.launch_ros",
+    "launch_testing": "rosl.compat.launch_testing",
+    "ament_index_python": "rosl.compat.ament_index_python",
 }
 
 

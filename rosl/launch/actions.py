@@ -7,15 +7,26 @@ import shlex
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rosl.launch.description import Action, LaunchDescription, check_required_arguments, process
+from rosl.launch.description import (
+    Action,
+    Condition,
+    LaunchDescription,
+    check_required_arguments,
+    process,
+)
 from rosl.launch.errors import LaunchError
-from rosl.launch.substitutions import SomeSubstitutions, perform, resolve_value
+from rosl.launch.event_handlers import OnProcessExit as OnProcessExit  # the supervisor's
+from rosl.launch.substitutions import (
+    ExecutableInPackage,
+    SomeSubstitutions,
+    perform,
+    resolve_value,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     from rosl.launch.context import LaunchContext
-    from rosl.launch.supervisor import ProcessEvent
 
 DEFAULT_DESCRIPTION = "no description given"
 
@@ -35,6 +46,12 @@ class DeclareLaunchArgument(Action):
         super().__init__(**kwargs)
         self.name = name
         self.default_value = default_value
+        if choices is not None:  # as launch words it, for `--show-args`
+            if description == DEFAULT_DESCRIPTION:
+                description = f"One of: {choices}"
+            else:
+                stop = "" if description.endswith(".") else "."
+                description = f"{description}{stop} Valid choices are: {choices}"
         self.description = description
         self.choices = choices
         self.conditionally_included = False
@@ -81,7 +98,56 @@ class SetEnvironmentVariable(Action):
 
     def execute(self, context: LaunchContext) -> None:
         """Record it in the scope's environment."""
-        context.scope.environment[perform(context, self.name)] = perform(context, self.value)
+        name = perform(context, self.name)
+        context.scope.environment[name] = perform(context, self.value)
+        context.scope.unset.discard(name)
+
+
+class UnsetEnvironmentVariable(Action):
+    """Remove an environment variable for processes started after it (in this scope)."""
+
+    def __init__(self, name: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record the removal in the scope."""
+        name = perform(context, self.name)
+        context.scope.environment.pop(name, None)
+        context.scope.unset.add(name)
+
+
+class AppendEnvironmentVariable(Action):
+    """Append (or prepend) to an environment variable, or set it if it is not set."""
+
+    def __init__(
+        self,
+        name: SomeSubstitutions,
+        value: SomeSubstitutions,
+        prepend: bool | SomeSubstitutions = False,
+        separator: SomeSubstitutions = os.pathsep,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.value = value
+        self.prepend = prepend
+        self.separator = separator
+
+    def execute(self, context: LaunchContext) -> None:
+        """Join the value to the variable as the scope (or this process) has it."""
+        name = perform(context, self.name)
+        value = perform(context, self.value)
+        separator = perform(context, self.separator)
+        current = context.environment.get(name)
+        if current is None:
+            joined = value
+        elif _flag(context, self.prepend):
+            joined = value + separator + current
+        else:
+            joined = current + separator + value
+        context.scope.environment[name] = joined
+        context.scope.unset.discard(name)
 
 
 class LogInfo(Action):
@@ -158,7 +224,7 @@ class IncludeLaunchDescription(Action):
         from rosl.launch.loader import load_description
 
         source = self.launch_description_source
-        path = Path(perform(context, getattr(source, "location", source)))
+        path = Path(perform(context, getattr(source, "location", source))).expanduser().resolve()
         for name, value in self.launch_arguments:
             context.launch_configurations[perform(context, name)] = perform(context, value)
         description = load_description(path)
@@ -239,7 +305,12 @@ class ExecuteProcess(Action):
     def command(self, context: LaunchContext) -> list[str]:
         """The resolved command line."""
         parts = self.cmd if isinstance(self.cmd, list) else [self.cmd]
-        argv = [perform(context, part) for part in parts]
+        argv: list[str] = []
+        for part in parts:  # a package's executable may be a Python entry: its whole argv
+            if isinstance(part, ExecutableInPackage):
+                argv += part.command(context)
+            else:
+                argv.append(perform(context, part))
         if self.shell:
             return ["/bin/sh", "-c", " ".join(argv)]
         return argv
@@ -248,6 +319,9 @@ class ExecuteProcess(Action):
         """The name shown as ``[name-N]``."""
         if self.name is not None:
             return perform(context, self.name)
+        first = self.cmd[0] if isinstance(self.cmd, list) and self.cmd else self.cmd
+        if isinstance(first, ExecutableInPackage):  # its file's name, even for a Python entry
+            return perform(context, first.executable)
         return os.path.basename(argv[0]) if argv else "process"
 
     def environment(self, context: LaunchContext) -> dict[str, str]:
@@ -255,7 +329,7 @@ class ExecuteProcess(Action):
         if self.env is not None:
             env = {perform(context, k): perform(context, v) for k, v in self.env.items()}
         else:
-            env = {**os.environ, **context.scope.environment}
+            env = context.environment
         for key, value in (self.additional_env or {}).items():
             env[perform(context, key)] = perform(context, value)
         return env
@@ -355,9 +429,12 @@ class OpaqueFunction(Action):
 class Shutdown(Action):
     """Shut the whole launch down (launch.actions.Shutdown, and the Shutdown event)."""
 
-    def __init__(self, *, reason: str = "shutdown requested", **kwargs: Any) -> None:
+    def __init__(
+        self, *, reason: str = "shutdown requested", due_to_sigint: bool = False, **kwargs: Any
+    ) -> None:
         super().__init__(**kwargs)
         self.reason = reason
+        self.due_to_sigint = due_to_sigint
 
     def execute(self, context: LaunchContext) -> None:
         """Ask the supervisor to stop everything."""
@@ -370,71 +447,42 @@ class EmitEvent(Action):
 
     def __init__(self, *, event: Any, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        if not isinstance(event, Shutdown):
+            raise LaunchError(
+                f"EmitEvent(event={type(event).__name__}(...)) is not supported by rosl: "
+                "the only event it emits is launch.events.Shutdown"
+            )
         self.event = event
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
         """Act on the event."""
-        if isinstance(self.event, Shutdown):
-            return [self.event]
-        raise LaunchError(
-            f"EmitEvent: rosl only supports Shutdown events, not {type(self.event).__name__}"
-        )
+        return [self.event]
 
 
-class EventHandler:
-    """Base of OnProcessStart / OnProcessExit."""
+class LaunchConfigurationEquals(Condition):
+    """True when a launch configuration has the given value (launch.conditions).
 
-    event_kind = ""
+    With ``expected_value=None``, true when the configuration is not set.
+    """
 
-    def __init__(self, *, target_action: Any = None, handler: Any = None) -> None:
-        self.target_action = target_action
-        self.handler = handler
+    def __init__(self, launch_configuration_name: str, expected_value: SomeSubstitutions) -> None:
+        self.launch_configuration_name = launch_configuration_name
+        self.expected_value = expected_value
 
-    def matches(self, event: ProcessEvent) -> bool:
-        """Whether this handler reacts to ``event``."""
-        return event.kind == self.event_kind and (
-            self.target_action is None or self.target_action is event.action
-        )
-
-    def entities(self, event: ProcessEvent, context: LaunchContext) -> list[Any]:
-        """The actions to run for ``event``."""
-        reaction = self.handler
-        if callable(reaction) and not hasattr(reaction, "visit"):
-            reaction = reaction(event, context)
-        if reaction is None:
-            return []
-        return list(reaction) if isinstance(reaction, (list, tuple)) else [reaction]
+    def evaluate(self, context: LaunchContext) -> bool:
+        """Compare the configuration with the expected value."""
+        value = context.launch_configurations.get(self.launch_configuration_name)
+        if self.expected_value is None:
+            return value is None
+        return value == perform(context, self.expected_value)
 
 
-class OnProcessStart(EventHandler):
-    """React when a process starts."""
+class LaunchConfigurationNotEquals(LaunchConfigurationEquals):
+    """True when a launch configuration does not have the given value."""
 
-    event_kind = "start"
-
-    def __init__(self, *, target_action: Any = None, on_start: Any = None) -> None:
-        super().__init__(target_action=target_action, handler=on_start)
-
-
-class OnProcessExit(EventHandler):
-    """React when a process exits."""
-
-    event_kind = "exit"
-
-    def __init__(self, *, target_action: Any = None, on_exit: Any = None) -> None:
-        super().__init__(target_action=target_action, handler=on_exit)
-
-
-class RegisterEventHandler(Action):
-    """Register an OnProcessStart/OnProcessExit handler."""
-
-    def __init__(self, event_handler: EventHandler, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.event_handler = event_handler
-
-    def execute(self, context: LaunchContext) -> None:
-        """Give the handler to the supervisor."""
-        if context.supervisor is not None:
-            context.supervisor.add_handler(self.event_handler, context)
+    def evaluate(self, context: LaunchContext) -> bool:
+        """The opposite of LaunchConfigurationEquals."""
+        return not super().evaluate(context)
 
 
 def launch_description_from(entities: list[Any]) -> LaunchDescription:

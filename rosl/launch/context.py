@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -18,6 +19,7 @@ class Scope:
     configurations: dict[str, str] = field(default_factory=dict)
     namespace: str = ""
     environment: dict[str, str] = field(default_factory=dict)
+    unset: set[str] = field(default_factory=set)  # removed from the environment (UnsetEnv...)
     parameters: list[tuple[str, Any]] = field(default_factory=list)
     remappings: list[tuple[str, str]] = field(default_factory=list)
 
@@ -43,6 +45,20 @@ class LaunchContext:
         return self.scope.configurations
 
     @property
+    def environment(self) -> dict[str, str]:
+        """The environment processes started now get (launch.LaunchContext.environment)."""
+        found = {**os.environ, **self.scope.environment}
+        for name in self.scope.unset:
+            found.pop(name, None)
+        return found
+
+    def perform_substitution(self, substitution: Any) -> str:
+        """A substitution's text in this context (launch.LaunchContext.perform_substitution)."""
+        from rosl.launch.substitutions import perform
+
+        return perform(self, substitution)
+
+    @property
     def current_file(self) -> Path | None:
         """The launch file being processed."""
         return self.files[-1] if self.files else None
@@ -60,6 +76,7 @@ class LaunchContext:
                 },
                 namespace=outer.namespace,
                 environment=dict(outer.environment),
+                unset=set(outer.unset),
                 parameters=list(outer.parameters),
                 remappings=list(outer.remappings),
             )

@@ -105,8 +105,9 @@ class LaunchDescription:
         found: list[Any] = []
 
         def walk(entity: Any, conditional: bool) -> None:
-            if isinstance(entity, DeclareLaunchArgument):
-                entity.conditionally_included = conditional
+            if isinstance(entity, DeclareLaunchArgument):  # its own condition counts too
+                own = getattr(entity, "condition", None) is not None
+                entity.conditionally_included = conditional or own
                 if entity.name not in [a.name for a in found]:
                     found.append(entity)
             nested = conditional or getattr(entity, "condition", None) is not None

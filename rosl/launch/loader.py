@@ -1,8 +1,9 @@
-"""Loading launch files: Python (``generate_launch_description()``) and ROS 2's YAML format.
+"""Loading launch files: Python (``generate_launch_description()``), ROS 2's XML and YAML.
 
-A Python launch file runs with ``launch``/``launch_ros`` served by rosl. Every problem is one
+A Python launch file runs with ``launch``/``launch_ros`` served by rosl; XML and YAML files are
+read by ``xml_format``/``yaml_format`` through the shared ``frontend``. Every problem is one
 line naming the file and line: a syntax error, an exception while the file runs, a missing
-``generate_launch_description``, a name rosl's launch does not provide.
+``generate_launch_description``, a name rosl's launch does not provide, an unknown tag.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ _cache: dict[Path, LaunchDescription] = {}
 
 
 def load_description(path: Path) -> LaunchDescription:
-    """Load a launch file (``.py``, ``.yaml``/``.yml``); cached per path.
+    """Load a launch file (``.py``, ``.xml``, ``.yaml``/``.yml``); cached per path.
 
     Raises:
         LaunchError: the file is missing, broken, or does not return a LaunchDescription.
@@ -33,7 +34,9 @@ def load_description(path: Path) -> LaunchDescription:
 
         description = load_yaml(path)
     elif path.suffix == ".xml":
-        raise LaunchError(f"{path}: XML launch files are not supported by rosl (use .py or .yaml)")
+        from rosl.launch.xml_format import load_xml
+
+        description = load_xml(path)
     else:
         description = _load_python(path)
     _cache[path] = description

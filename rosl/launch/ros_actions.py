@@ -1,5 +1,9 @@
 """launch_ros's actions: Node, PushRosNamespace, SetParameter, SetRemap (and ParameterValue).
 
+Components (ComposableNodeContainer, LoadComposableNodes) and LifecycleNode are refused with
+one line naming the launch file's line: components are C++ plugins, and rosl has no managed
+nodes yet.
+
 A Node becomes ``<executable> [arguments] --ros-args -r __node:=NAME -r __ns:=NS
 --params-file FILE -r from:=to ...`` — the same ``--ros-args`` a user could type. Parameter
 dicts are written to a YAML file in the launch's log folder, as ROS 2 does.
@@ -7,13 +11,20 @@ dicts are written to a YAML file in the launch's log folder, as ROS 2 does.
 
 from __future__ import annotations
 
+import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rosl.launch.actions import ExecuteProcess
 from rosl.launch.description import Action
 from rosl.launch.errors import LaunchError
-from rosl.launch.substitutions import SomeSubstitutions, Substitution, perform, resolve_value
+from rosl.launch.substitutions import (
+    SomeSubstitutions,
+    Substitution,
+    describe,
+    perform,
+    resolve_value,
+)
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
@@ -31,7 +42,19 @@ class ParameterValue:
         self.value_type = value_type
 
 
-def _yaml_typed(text: str) -> Any:
+class ParameterFile:
+    """A parameter file given to a Node (launch_ros.descriptions.ParameterFile)."""
+
+    def __init__(self, param_file: SomeSubstitutions, *, allow_substs: bool = False) -> None:
+        if allow_substs:
+            raise LaunchError(
+                "ParameterFile(allow_substs=True) is not supported by rosl: substitutions "
+                "inside a parameter file are not expanded; pass the values as a dict instead"
+            )
+        self.param_file = param_file
+
+
+def yaml_typed(text: str) -> Any:
     """``'0.9'`` -> 0.9, ``'true'`` -> True, ``'[1, 2]'`` -> [1, 2]; other text stays text."""
     import yaml
 
@@ -73,14 +96,14 @@ def parameter_value(context: LaunchContext, value: Any) -> Any:
             if kind is str:
                 return perform(context, value.value) if _substituted(value.value) else str(resolved)
             if kind is bool and isinstance(resolved, str):
-                return _yaml_typed(resolved) is True
+                return yaml_typed(resolved) is True
             return kind(resolved)
         except (TypeError, ValueError):
             raise LaunchError(
                 f"parameter value {resolved!r} is not a {getattr(kind, '__name__', kind)}"
             ) from None
     if _substituted(value):
-        return _yaml_typed(perform(context, value))
+        return yaml_typed(perform(context, value))
     if isinstance(value, dict):
         return {perform(context, k): parameter_value(context, v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -133,8 +156,8 @@ class Node(ExecuteProcess):
             if isinstance(entry, dict):
                 for key, value in entry.items():
                     values[perform(context, key)] = parameter_value(context, value)
-            elif isinstance(entry, (str, Path, Substitution, list, tuple)):
-                path = Path(perform(context, entry) if not isinstance(entry, Path) else entry)
+            elif isinstance(entry, (str, Path, Substitution, list, tuple, ParameterFile)):
+                path = _parameter_file(context, entry)
                 if not path.is_file():
                     raise LaunchError(
                         f"parameter file {path} (for {self._label(context)}) does not exist"
@@ -225,10 +248,14 @@ class Node(ExecuteProcess):
                     {perform(context, k): parameter_value(context, v) for k, v in entry.items()}
                 )
             else:
-                values[
-                    f"(file) {perform(context, entry) if not isinstance(entry, Path) else entry}"
-                ] = "..."
+                values[f"(file) {_parameter_file(context, entry)}"] = "..."
         return [], values
+
+
+def _parameter_file(context: LaunchContext, entry: Any) -> Path:
+    if isinstance(entry, ParameterFile):
+        entry = entry.param_file
+    return entry if isinstance(entry, Path) else Path(perform(context, entry))
 
 
 class PushRosNamespace(Action):
@@ -267,6 +294,88 @@ class SetRemap(Action):
     def execute(self, context: LaunchContext) -> None:
         """Record it on the current scope."""
         context.scope.remappings.append((self.src, self.dst))
+
+
+class ComposableNode:
+    """A C++ component to load into a container (launch_ros.descriptions.ComposableNode).
+
+    Kept as given: the container or LoadComposableNodes that receives it refuses to run.
+    """
+
+    def __init__(
+        self,
+        *,
+        package: SomeSubstitutions,
+        plugin: SomeSubstitutions,
+        name: SomeSubstitutions = None,
+        namespace: SomeSubstitutions = None,
+        **kwargs: Any,
+    ) -> None:
+        self.package = package
+        self.plugin = plugin
+        self.name = name
+        self.namespace = namespace
+        self.options = kwargs
+
+
+def _user_site() -> str:
+    """``file:line: `` of the innermost caller outside rosl (the launch file's line)."""
+    rosl_dir = Path(__file__).resolve().parents[1]
+    for frame in reversed(traceback.extract_stack()):
+        path = Path(frame.filename)
+        if path.is_file() and rosl_dir not in path.resolve().parents:
+            return f"{frame.filename}:{frame.lineno}: "
+    return ""
+
+
+def _shown(value: SomeSubstitutions) -> str:
+    return value if isinstance(value, str) else describe(value)
+
+
+def _refuse_components(what: str, descriptions: Any) -> LaunchError:
+    plugins = [
+        _shown(d.plugin) if isinstance(d, ComposableNode) else type(d).__name__
+        for d in (descriptions or [])
+    ]
+    listed = f": {', '.join(plugins)}" if plugins else ""
+    return LaunchError(
+        f"{_user_site()}'launch_ros.actions.{what}' is not supported: it runs C++ components, "
+        f"which rosl cannot{listed} (start each as a Node of a Python package instead)"
+    )
+
+
+class ComposableNodeContainer(Action):
+    """Refused when created: a component container loads C++ plugins."""
+
+    def __init__(self, *, composable_node_descriptions: Any = None, **kwargs: Any) -> None:
+        raise _refuse_components("ComposableNodeContainer", composable_node_descriptions)
+
+
+class LoadComposableNodes(Action):
+    """Refused when created: it loads C++ plugins into a container."""
+
+    def __init__(self, *, composable_node_descriptions: Any = None, **kwargs: Any) -> None:
+        raise _refuse_components("LoadComposableNodes", composable_node_descriptions)
+
+
+NO_LIFECYCLE = "rosl has no managed (lifecycle) nodes yet"
+
+
+def refuse_lifecycle(module: str, name: str) -> LaunchError:
+    """The one line for a lifecycle name of launch_ros (LifecycleNode, ChangeState, ...)."""
+    return LaunchError(f"{_user_site()}'{module}.{name}' is not supported: {NO_LIFECYCLE}")
+
+
+class LifecycleNode(Action):
+    """Refused when created: rosl has no managed (lifecycle) nodes yet."""
+
+    def __init__(self, *, name: SomeSubstitutions = None, **kwargs: Any) -> None:
+        node = f" '{_shown(name)}'" if name is not None else ""
+        error = refuse_lifecycle("launch_ros.actions", "LifecycleNode")
+        raise LaunchError(
+            f"{error}; start the node{node} with launch_ros.actions.Node if it needs no "
+            "lifecycle transitions"
+        )
 
 
 def _yaml_value(value: Any) -> str:

@@ -4,21 +4,26 @@ from __future__ import annotations
 
 import os
 import shlex
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from rosl.launch.context import LaunchContext
-from rosl.launch.description import check_required_arguments, process
+from rosl.launch.description import Action, check_required_arguments, process
 from rosl.launch.loader import load_description
 from rosl.launch.substitutions import describe
 from rosl.launch.supervisor import Supervisor
 
 if TYPE_CHECKING:
-    from pathlib import Path
+    from rosl.launch.description import LaunchDescription
 
 
 def show_arguments(path: Path) -> list[str]:
     """The lines ``ros2 launch --show-args`` prints."""
-    description = load_description(path)
+    return argument_lines(load_description(path))
+
+
+def argument_lines(description: LaunchDescription) -> list[str]:
+    """The lines ``--show-args`` prints for a loaded description (also ``launch_test -s``)."""
     arguments = description.get_launch_arguments()
     lines = ["Arguments (pass arguments as '<name>:=<value>'):"]
     conditional = False
@@ -131,3 +136,31 @@ def start_recorder(supervisor: Supervisor, folder: Path) -> None:
         supervisor.shutdown("the recorder did not start")
         supervisor.run()
         raise LaunchError("the recorder did not start (its output is above); nothing was launched")
+
+
+class Record(Action):
+    """Record everything on the bus from this point of the launch on (a launch action).
+
+    ``rosl bag record -a --include-services -o OUTPUT`` starts, and the launch goes on once it
+    listens; it is stopped last, after every other process, so the bag holds the whole run::
+
+        record = Record()  # a fresh folder; or Record(output="run1")
+        return LaunchDescription([record, Node(...), ReadyToTest()]), {"bag": record.output}
+
+    Args:
+        output: the bag folder to create (it must not exist); by default ``bag`` in a new
+            temporary folder.
+    """
+
+    def __init__(self, output: str | Path | None = None, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        if output is None:
+            import tempfile
+
+            output = Path(tempfile.mkdtemp(prefix="rosl_record_")) / "bag"
+        self.output = Path(output)
+
+    def execute(self, context: LaunchContext) -> None:
+        """Start the recorder and wait (bounded) until it records."""
+        if context.supervisor is not None and not context.supervisor.dry_run:
+            start_recorder(context.supervisor, self.output)

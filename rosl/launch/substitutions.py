@@ -7,13 +7,14 @@ any process starts, so a missing launch argument is an error at once, naming it.
 
 from __future__ import annotations
 
-import math
 import os
 from typing import TYPE_CHECKING, Any
 
 from rosl.launch.errors import LaunchError
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from rosl.launch.context import LaunchContext
 
 SomeSubstitutions = Any  # str | Substitution | list of them
@@ -64,9 +65,15 @@ class LaunchConfiguration(Substitution):
         if self.default is not None:
             return perform(context, self.default)
         where = f"{context.current_file}: " if context.current_file else ""
+        declare = {  # in the words of the file's format
+            ".xml": f'<arg name="{name}" default="..."/>',
+            ".yaml": f"'- arg: {{name: {name}, default: ...}}'",
+            ".yml": f"'- arg: {{name: {name}, default: ...}}'",
+        }.get(getattr(context.current_file, "suffix", ""))
         raise LaunchError(
             f"{where}launch configuration '{name}' is not set: declare it with "
-            f"DeclareLaunchArgument('{name}', default_value=...) or pass {name}:=<value>"
+            f"{declare or f'DeclareLaunchArgument({name!r}, default_value=...)'} "
+            f"or pass {name}:=<value>"
         )
 
     def describe(self) -> str:
@@ -111,45 +118,331 @@ class PathJoinSubstitution(Substitution):
         return " + '/' + ".join(describe(part) for part in self.substitutions)
 
 
-class FindPackageShare(Substitution):
-    """A package's share folder — in rosl, the package's folder."""
+class FindPackage(Substitution):
+    """A package's prefix — in rosl, the package's folder (launch_ros.substitutions)."""
 
     def __init__(self, package: SomeSubstitutions) -> None:
         self.package = package
 
-    def perform(self, context: LaunchContext) -> str:
-        """The package folder."""
+    @classmethod
+    def find(cls, package: str) -> str:
+        """The folder of ``package``, without a launch context.
+
+        Raises:
+            LaunchError: no such package.
+        """
         from rosl.pkg.errors import PackageError
         from rosl.pkg.manifest import get_package
 
         try:
-            return str(get_package(perform(context, self.package)).path)
+            return str(get_package(package).path)
         except PackageError as err:
             raise LaunchError(str(err)) from None
+
+    def perform(self, context: LaunchContext) -> str:
+        """The package folder."""
+        return self.find(perform(context, self.package))
 
     def describe(self) -> str:
         """``Pkg(pkg='name')``, as launch_ros describes it."""
         return f"Pkg(pkg={describe(self.package)})"
 
 
-FindPackagePrefix = FindPackageShare
+class FindPackagePrefix(FindPackage):
+    """``$(find-pkg-prefix P)``: the package's prefix (its folder in rosl)."""
+
+
+class FindPackageShare(FindPackage):
+    """``$(find-pkg-share P)``: the package's share folder (its folder in rosl)."""
+
+
+class ExecutableInPackage(FindPackage):
+    """The path of a package's executable (launch_ros.substitutions.ExecutableInPackage).
+
+    rosl's executables are often Python entry points (``module:main``) rather than files; those
+    have no path of their own, and ``command()`` gives the argv that starts them.
+    """
+
+    def __init__(self, executable: SomeSubstitutions, package: SomeSubstitutions) -> None:
+        super().__init__(package)
+        self.executable = executable
+
+    def command(self, context: LaunchContext) -> list[str]:
+        """The argv that starts the executable (its path, or rosl's entry for a module)."""
+        from rosl.pkg.errors import PackageError
+        from rosl.pkg.executables import command_line, find_executable
+
+        try:
+            found = find_executable(
+                perform(context, self.package), perform(context, self.executable)
+            )
+            return command_line(found, [])
+        except PackageError as err:
+            raise LaunchError(str(err)) from None
+
+    def perform(self, context: LaunchContext) -> str:
+        """The executable's path."""
+        argv = self.command(context)
+        if len(argv) != 1:
+            raise LaunchError(
+                f"executable '{perform(context, self.executable)}' of package "
+                f"'{perform(context, self.package)}' is a Python entry point, not a file; "
+                "start it with a node (Node(package=, executable=) or <node pkg= exec=>)"
+            )
+        return argv[0]
+
+    def describe(self) -> str:
+        """``ExecInPkg(pkg='p', exec='e')``."""
+        return f"ExecInPkg(pkg={describe(self.package)}, exec={describe(self.executable)})"
+
+
+class FindExecutable(Substitution):
+    """The path of an executable found on the PATH (``$(find-exec NAME)``)."""
+
+    def __init__(self, *, name: SomeSubstitutions) -> None:
+        self.name = name
+
+    def perform(self, context: LaunchContext) -> str:
+        """The executable's full path."""
+        import shutil
+
+        name = perform(context, self.name)
+        path = context.scope.environment.get("PATH", os.environ.get("PATH"))
+        found = shutil.which(name, path=path)
+        if found is None:
+            raise LaunchError(f"executable '{name}' not found on the PATH")
+        return found
+
+    def describe(self) -> str:
+        """``FindExec('name')``."""
+        return f"FindExec({describe(self.name)})"
+
+
+class ThisLaunchFile(Substitution):
+    """The path of the launch file being processed (``$(filename)``)."""
+
+    def __init__(self, *, path: Path | None = None) -> None:
+        self.path = path  # a frontend (XML/YAML) knows its file when it reads it
+
+    def _file(self, context: LaunchContext) -> Path:
+        if self.path is not None:
+            return self.path
+        if context.current_file is None:
+            raise LaunchError(f"{type(self).__name__} used outside of a launch file")
+        return context.current_file.resolve()  # absolute, as the loader names files
+
+    def perform(self, context: LaunchContext) -> str:
+        """The file's absolute path."""
+        return str(self._file(context))
+
+    def describe(self) -> str:
+        """``ThisLaunchFile()``."""
+        return f"{type(self).__name__}()"
+
+
+class ThisLaunchFileDir(ThisLaunchFile):
+    """The folder of the launch file being processed (``$(dirname)``)."""
+
+    def perform(self, context: LaunchContext) -> str:
+        """The file's folder."""
+        return str(self._file(context).parent)
+
+
+class AnonName(Substitution):
+    """A name made unique for this launch: the same ``name`` gives the same result."""
+
+    def __init__(self, name: SomeSubstitutions) -> None:
+        self.name = name
+
+    def perform(self, context: LaunchContext) -> str:
+        """``name_<pid>_<random>``, fixed per name for the whole launch."""
+        import random
+
+        name = perform(context, self.name)
+        names: dict[str, str] = context.locals.setdefault("anon", {})
+        if name not in names:
+            names[name] = f"{name}_{os.getpid()}_{random.randrange(1 << 62)}"
+        return names[name]
+
+    def describe(self) -> str:
+        """``AnonName('name')``."""
+        return f"AnonName({describe(self.name)})"
 
 
 class PythonExpression(Substitution):
-    """Evaluate a Python expression built from substitutions (``math`` available)."""
+    """Evaluate a Python expression built from substitutions.
 
-    def __init__(self, expression: list[SomeSubstitutions]) -> None:
+    As in launch: the names of ``math`` are there directly (``pi``, ``sin``), each module of
+    ``python_modules`` under its name, and Python's builtins (``int``, ``len``).
+    """
+
+    def __init__(
+        self, expression: SomeSubstitutions, python_modules: SomeSubstitutions = ("math",)
+    ) -> None:
         self.expression = expression
+        self.python_modules = python_modules
+
+    def _scope(self, context: LaunchContext) -> dict[str, Any]:
+        import importlib
+
+        modules = self.python_modules
+        entries = [modules] if isinstance(modules, (str, Substitution)) else list(modules)
+        scope: dict[str, Any] = {}
+        for entry in entries:
+            name = perform(context, entry).strip()
+            try:
+                module = importlib.import_module(name)
+            except ImportError:
+                raise LaunchError(f"PythonExpression: no Python module '{name}'") from None
+            if name == "math":
+                scope.update(vars(module))
+            scope[name] = module
+        return scope
 
     def perform(self, context: LaunchContext) -> str:
         """The expression's value as text."""
+        scope = self._scope(context)
         text = perform(context, self.expression)
         try:
-            return str(eval(text, {"math": math, "__builtins__": {}}))
+            return str(eval(text, {}, scope))
         except Exception as err:
             raise LaunchError(
                 f"PythonExpression '{text}' failed: {type(err).__name__}: {err}"
             ) from None
+
+    def describe(self) -> str:
+        """``PythonExpr(expression)``."""
+        return f"PythonExpr({describe(self.expression)})"
+
+
+class Command(Substitution):
+    """The standard output of a command (``$(command '...' [fail|warn|ignore|capture])``).
+
+    The command text is split into words as a shell would (``shlex``) and run without a shell,
+    for at most ``TIMEOUT_SEC``. ``on_stderr``: ``fail`` (anything on stderr is an error),
+    ``warn`` (logged), ``ignore``, or ``capture`` (kept with stdout). A failing command is an
+    error naming it.
+    """
+
+    TIMEOUT_SEC = 120.0
+
+    def __init__(
+        self, command: SomeSubstitutions, *, on_stderr: SomeSubstitutions = "fail"
+    ) -> None:
+        self.command = command
+        self.on_stderr = on_stderr
+
+    def perform(self, context: LaunchContext) -> str:
+        """Run the command; its standard output."""
+        import shlex
+
+        text = perform(context, self.command)
+        mode = perform(context, self.on_stderr)
+        if mode not in ("fail", "warn", "ignore", "capture"):
+            raise LaunchError(
+                f"command '{text}': on_stderr is '{mode}', not one of fail, warn, ignore, capture"
+            )
+        try:
+            argv = shlex.split(text)
+        except ValueError as bad:
+            raise LaunchError(f"command '{text}' cannot be split into words: {bad}") from None
+        if not argv:
+            raise LaunchError("a command substitution with no command")
+        code, out, err = self._run(text, argv, mode, {**os.environ, **context.scope.environment})
+        if code != 0:
+            said = f": {err.splitlines()[-1]}" if err else ""
+            raise LaunchError(f"command '{text}' exited with code {code}{said}")
+        if err and mode == "fail":
+            raise LaunchError(
+                f"command '{text}' wrote to stderr: {err.splitlines()[0]} (give 'warn' or "
+                "'ignore' as its second argument to allow that)"
+            )
+        if err and mode == "warn" and context.supervisor is not None:
+            context.supervisor.log("WARNING", "launch", f"command '{text}' wrote to stderr: {err}")
+        return out
+
+    def _run(
+        self, text: str, argv: list[str], mode: str, env: dict[str, str]
+    ) -> tuple[int, str, str]:
+        import subprocess
+
+        try:
+            done = subprocess.run(
+                argv, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT if mode == "capture" else subprocess.PIPE,
+                text=True, env=env, timeout=self.TIMEOUT_SEC, check=False,
+            )  # fmt: skip
+        except FileNotFoundError:
+            raise LaunchError(f"command '{text}' failed: '{argv[0]}' not found") from None
+        except OSError as err:
+            raise LaunchError(f"command '{text}' failed: {err.strerror}") from None
+        except subprocess.TimeoutExpired:
+            raise LaunchError(
+                f"command '{text}' did not finish within {self.TIMEOUT_SEC:g} s"
+            ) from None
+        return done.returncode, done.stdout or "", (done.stderr or "").strip()
+
+    def describe(self) -> str:
+        """``Command(...)``."""
+        return f"Command({describe(self.command)})"
+
+
+def _boolean(context: LaunchContext, value: SomeSubstitutions, what: str) -> bool:
+    text = perform(context, value).strip().lower()
+    if text in ("true", "1"):
+        return True
+    if text in ("false", "0"):
+        return False
+    raise LaunchError(f"{what}: '{text}' is not a boolean (true/false or 1/0)")
+
+
+class NotSubstitution(Substitution):
+    """``'true'`` when the value is false (``$(not V)``)."""
+
+    def __init__(self, value: SomeSubstitutions) -> None:
+        self.value = value
+
+    def perform(self, context: LaunchContext) -> str:
+        """``'true'`` or ``'false'``."""
+        return str(not _boolean(context, self.value, "not")).lower()
+
+    def describe(self) -> str:
+        """``NotSubstitution(...)``."""
+        return f"NotSubstitution({describe(self.value)})"
+
+
+class AndSubstitution(Substitution):
+    """``'true'`` when both values are true (``$(and L R)``)."""
+
+    word = "and"
+
+    def __init__(self, left: SomeSubstitutions, right: SomeSubstitutions) -> None:
+        self.left = left
+        self.right = right
+
+    def combine(self, left: bool, right: bool) -> bool:
+        """The logical operation."""
+        return left and right
+
+    def perform(self, context: LaunchContext) -> str:
+        """``'true'`` or ``'false'``."""
+        left = _boolean(context, self.left, self.word)
+        right = _boolean(context, self.right, self.word)
+        return str(self.combine(left, right)).lower()
+
+    def describe(self) -> str:
+        """``AndSubstitution(left right)``."""
+        return f"{type(self).__name__}({describe(self.left)} {describe(self.right)})"
+
+
+class OrSubstitution(AndSubstitution):
+    """``'true'`` when either value is true (``$(or L R)``)."""
+
+    word = "or"
+
+    def combine(self, left: bool, right: bool) -> bool:
+        """The logical operation."""
+        return left or right
 
 
 def perform(context: LaunchContext, value: SomeSubstitutions) -> str:

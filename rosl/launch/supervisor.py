@@ -7,6 +7,10 @@ when it is SIGKILLed. On shutdown each child gets SIGINT, then SIGTERM after
 Output lines are prefixed ``[name-N]`` (coloured on a terminal, plain when piped or with
 NO_COLOR) and routed by ``output`` as ROS 2 does: 'screen', 'log' (stdout to the launch log,
 stderr to both), 'both'.
+
+Watchers (``Supervisor.watchers``, launch_testing's handlers) see every launched process start,
+print a line (stdout or stderr, whatever ``output`` says) and exit, on the supervising thread;
+``request_shutdown`` may be called from any thread.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -65,14 +70,25 @@ class ProcessSpec:
 
 @dataclass(slots=True)
 class ProcessEvent:
-    """A process started or exited (what event handlers see)."""
+    """A process started, printed a line or exited (what event handlers and watchers see)."""
 
-    kind: str  # "start" | "exit"
+    kind: str  # "start" | "exit"; watchers also see "stdout" | "stderr"
     action: Any
     name: str
     pid: int
     returncode: int | None = None
     cmd: list[str] = field(default_factory=list)
+    text: str = ""  # the line printed ("stdout"/"stderr" events), without its newline
+
+
+@dataclass(slots=True)
+class ShutdownEvent:
+    """The launch begins to shut down (what OnShutdown handlers see: launch's Shutdown event)."""
+
+    reason: str
+    due_to_sigint: bool = False
+    kind: str = "shutdown"
+    action: Any = None
 
 
 @dataclass(slots=True)
@@ -129,6 +145,9 @@ class Supervisor:
         self._interrupt_pending = False
         self._watch: tuple[str, str] | None = None
         self._seen = False
+        self.watchers: list[Callable[[ProcessEvent], None]] = []  # see every launched process
+        self.keep_alive = False  # run() goes on after the last process, until a shutdown
+        self._requests: list[str] = []  # shutdowns asked for by other threads
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -221,8 +240,10 @@ class Supervisor:
             os.set_blocking(pipe.fileno(), False)
             self._selector.register(pipe, selectors.EVENT_READ, running)
         self.log("INFO", label, f"process started with pid [{popen.pid}]")
+        started = ProcessEvent("start", action, label, popen.pid, None, spec.cmd)
+        self._notify(running, started)
         if context is not None:
-            self._emit(ProcessEvent("start", action, label, popen.pid, None, spec.cmd), context)
+            self._emit(started, context)
         return label
 
     def wait_for_line(self, label: str, text: str, timeout: float) -> bool:
@@ -245,7 +266,12 @@ class Supervisor:
         """Register an OnProcessStart/OnProcessExit handler."""
         self._handlers.append((handler, context))
 
-    def _emit(self, event: ProcessEvent, context: LaunchContext) -> None:
+    def _notify(self, running: Running, event: ProcessEvent) -> None:
+        if running.action is not None:  # not the launcher's own helpers (the recorder)
+            for watcher in self.watchers:
+                watcher(event)
+
+    def _emit(self, event: ProcessEvent | ShutdownEvent, context: LaunchContext | None) -> None:
         from rosl.launch.description import process
 
         for handler, handler_context in list(self._handlers):
@@ -259,6 +285,15 @@ class Supervisor:
         """Whether the launch is shutting down (Ctrl-C, or its work is done)."""
         return self._shutdown_reason is not None
 
+    @property
+    def interrupted(self) -> bool:
+        """Whether a SIGINT or SIGTERM reached the launcher."""
+        return self._interrupts > 0
+
+    def request_shutdown(self, reason: str) -> None:
+        """Ask for ``shutdown(reason)`` from any thread; the supervising loop does it (≤ 0.1 s)."""
+        self._requests.append(reason)
+
     def shutdown(self, reason: str) -> None:
         """Stop every process (SIGINT, then escalation) and start nothing more."""
         if self._shutdown_reason is not None:
@@ -266,6 +301,7 @@ class Supervisor:
         self._shutdown_reason = reason
         self._timers.clear()
         self._respawns.clear()
+        self._emit(ShutdownEvent(reason, self._interrupts > 0), None)  # OnShutdown handlers
         for running in self._running:
             if not running.spec.background:  # helpers (the recorder) stop after the rest
                 self._signal(running, signal.SIGINT)
@@ -296,6 +332,8 @@ class Supervisor:
     def _handle_signals(self) -> None:
         while self._signals:
             self._handle_signal(self._signals.pop(0))
+        while self._requests:
+            self.shutdown(self._requests.pop(0))
 
     def _handle_signal(self, signum: int) -> None:
         self._interrupts += 1
@@ -318,7 +356,10 @@ class Supervisor:
         A background job of a shell starts with SIGINT ignored; the launcher takes it anyway
         (as ``ros2 launch`` does), so one ``kill -INT`` always ends the launch.
         """
-        if self._previous_handlers is None:
+        if (
+            self._previous_handlers is None
+            and threading.current_thread() is threading.main_thread()
+        ):
             self._previous_handlers = {
                 s: signal.signal(s, self._on_signal) for s in (signal.SIGINT, signal.SIGTERM)
             }
@@ -337,11 +378,12 @@ class Supervisor:
         try:
             self._handle_signals()  # any received while the launch file loaded
             while self._running or (
-                self._shutdown_reason is None and (self._timers or self._respawns)
+                self._shutdown_reason is None
+                and (self._timers or self._respawns or self.keep_alive)
             ):
                 self._handle_signals()
                 foreground = [r for r in self._running if not r.spec.background]
-                pending = self._timers or self._respawns
+                pending = self._timers or self._respawns or self.keep_alive
                 if self._shutdown_reason is None and not foreground and not pending:
                     self.shutdown("all processes have finished")
                 if self._shutdown_reason is not None:
@@ -354,6 +396,8 @@ class Supervisor:
                             if not helper.stopping:
                                 self._signal(helper, signal.SIGINT)
                 self._step()
+            if self._shutdown_reason is None:  # the last process ended: the launch is done
+                self.shutdown("all processes have finished")  # (OnShutdown handlers run)
         finally:
             self.kill_all()
             if installed_here:
@@ -432,6 +476,11 @@ class Supervisor:
         text = raw.decode("utf-8", "replace").rstrip("\r")
         if self._watch is not None and running.label == self._watch[0] and self._watch[1] in text:
             self._seen = True
+        if self.watchers:
+            kind = "stderr" if stderr else "stdout"
+            pid = running.popen.pid
+            self._notify(running, ProcessEvent(kind, running.action, running.label, pid,
+                                               None, running.spec.cmd, text))  # fmt: skip
         output = running.spec.output
         to_screen = output in ("screen", "both") or (output == "log" and stderr)
         to_log = output in ("log", "both")
@@ -468,8 +517,9 @@ class Supervisor:
             )
             if not running.stopping:
                 self.failed.append(running.label)
+        event = ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd)
+        self._notify(running, event)
         if running.context is not None:
-            event = ProcessEvent("exit", running.action, running.label, pid, code, running.spec.cmd)
             self._emit(event, running.context)
             on_exit = getattr(running.action, "on_exit", None)
             if on_exit is not None:  # ExecuteProcess(on_exit=...): a handler for itself

@@ -94,6 +94,9 @@ def test_show_args_marks_conditionally_declared_arguments_and_says_when_there_ar
                     [DeclareLaunchArgument("extra", default_value="1", description="Extra")],
                     condition=IfCondition(LaunchConfiguration("use_extra")),
                 ),
+                DeclareLaunchArgument(  # its own condition marks it too
+                    "own", default_value="2", condition=IfCondition("true"), choices=["2", "3"]
+                ),
             ])
         """,
     )
@@ -121,6 +124,10 @@ def test_show_args_marks_conditionally_declared_arguments_and_says_when_there_ar
         "    'extra'*:\n"
         "        Extra\n"
         "        (default: '1')\n"
+        "\n"
+        "    'own'*:\n"
+        "        One of: ['2', '3']\n"
+        "        (default: '2')\n"
         "\n"
         "* argument(s) which are only declared if specific conditions occur"
     )

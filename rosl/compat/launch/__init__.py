@@ -1,8 +1,37 @@
-"""``import launch`` under rosl (the launch API rosl implements; no logic here)."""
+"""``import launch`` under rosl (the launch API rosl implements; no logic here).
+
+Submodules (``launch.actions``, ``launch.substitutions``, ...) are reachable after
+``import launch``, as with launch, and imported on first use.
+"""
+
+import importlib
+from typing import Any
 
 from rosl.compat.unsupported import unsupported_names
 from rosl.launch.context import LaunchContext
-from rosl.launch.description import LaunchDescription
+from rosl.launch.description import Action, Condition, LaunchDescription
+from rosl.launch.event_handlers import EventHandler
+from rosl.launch.substitutions import SomeSubstitutions as SomeSubstitutionsType
+from rosl.launch.substitutions import Substitution
 
-__all__ = ["LaunchContext", "LaunchDescription"]
-__getattr__ = unsupported_names("launch", __all__)
+__all__ = [
+    "Action",
+    "Condition",
+    "EventHandler",
+    "LaunchContext",
+    "LaunchDescription",
+    "SomeSubstitutionsType",
+    "Substitution",
+]
+
+_SUBMODULES = frozenset(
+    ("actions", "conditions", "event_handlers", "events", "launch_description_sources",
+     "substitutions", "utilities")
+)  # fmt: skip
+_unsupported = unsupported_names("launch", [*__all__, *sorted(_SUBMODULES)])
+
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(f"launch.{name}")
+    return _unsupported(name)

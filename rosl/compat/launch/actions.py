@@ -2,6 +2,7 @@
 
 from rosl.compat.unsupported import unsupported_names
 from rosl.launch.actions import (
+    AppendEnvironmentVariable,
     DeclareLaunchArgument,
     EmitEvent,
     ExecuteProcess,
@@ -9,14 +10,16 @@ from rosl.launch.actions import (
     IncludeLaunchDescription,
     LogInfo,
     OpaqueFunction,
-    RegisterEventHandler,
     SetEnvironmentVariable,
     SetLaunchConfiguration,
     Shutdown,
     TimerAction,
+    UnsetEnvironmentVariable,
 )
+from rosl.launch.event_handlers import RegisterEventHandler
 
 __all__ = [
+    "AppendEnvironmentVariable",
     "DeclareLaunchArgument",
     "EmitEvent",
     "ExecuteProcess",
@@ -29,5 +32,6 @@ __all__ = [
     "SetLaunchConfiguration",
     "Shutdown",
     "TimerAction",
+    "UnsetEnvironmentVariable",
 ]
 __getattr__ = unsupported_names("launch.actions", __all__)

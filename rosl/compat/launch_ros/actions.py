@@ -1,7 +1,26 @@
-"""launch_ros.actions."""
+"""launch_ros.actions (components and lifecycle nodes are refused in one line)."""
 
 from rosl.compat.unsupported import unsupported_names
-from rosl.launch.ros_actions import Node, PushRosNamespace, SetParameter, SetRemap
+from rosl.launch.ros_actions import (
+    ComposableNodeContainer,
+    LifecycleNode,
+    LoadComposableNodes,
+    Node,
+    PushRosNamespace,
+    SetParameter,
+    SetRemap,
+)
 
-__all__ = ["Node", "PushRosNamespace", "SetParameter", "SetRemap"]
+PushROSNamespace = PushRosNamespace  # the later distros' spelling
+
+__all__ = [
+    "ComposableNodeContainer",
+    "LifecycleNode",
+    "LoadComposableNodes",
+    "Node",
+    "PushROSNamespace",
+    "PushRosNamespace",
+    "SetParameter",
+    "SetRemap",
+]
 __getattr__ = unsupported_names("launch_ros.actions", __all__)

@@ -1,0 +1,9 @@
+"""launch_testing.actions (rosl.launch.testing.actions implements it; no logic here)."""
+
+from rosl.launch.testing.actions import (
+    ReadyToTest,
+)
+
+__all__ = [
+    "ReadyToTest",
+]

@@ -1,0 +1,199 @@
+"""Running one launch test: the launch on this thread, the active tests on another.
+
+As launch_testing does: the launch description starts; once its ReadyToTest action runs, the
+active tests run on a second thread while the supervisor watches the processes; when they end,
+the launch is shut down (SIGINT, then escalation), and the post-shutdown tests run with every
+exit code and line of output. Without ``launch_testing.markers.keep_alive`` the launch also ends
+when its last process does; active tests still running then fail the run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import threading
+import unittest
+from dataclasses import dataclass, field
+from typing import IO, TYPE_CHECKING, Any
+
+from rosl.launch.testing.io_handler import ActiveIoHandler, ProcessIO
+from rosl.launch.testing.proc_info_handler import (
+    ActiveProcInfoHandler,
+    ProcessExited,
+    ProcessStarted,
+)
+
+if TYPE_CHECKING:
+    from rosl.launch.supervisor import ProcessEvent, Supervisor
+    from rosl.launch.testing.loader import TestRun
+
+DIED = "Processes under test stopped before tests completed"
+
+
+@dataclass(slots=True)
+class RunResult:
+    """The results of one launch test: unittest results, or why the active tests never ended."""
+
+    results: list[unittest.TestResult] = field(default_factory=list)
+    problem: str | None = None  # the launch ended before the active tests did
+    interrupted: bool = False  # Ctrl-C
+
+    def wasSuccessful(self) -> bool:  # noqa: N802 - unittest's word
+        """Whether every test passed and the launch lasted until the active tests ended."""
+        return self.problem is None and all(r.wasSuccessful() for r in self.results)
+
+    def failures(self) -> list[tuple[str, str]]:
+        """(``Class.test_method``, formatted traceback) of every failed or broken test."""
+        return [
+            (f"{type(test).__name__}.{getattr(test, '_testMethodName', test)}", text)
+            for result in self.results
+            for test, text in [*result.errors, *result.failures]
+        ]
+
+
+class LaunchServiceHandle:
+    """What tests get as ``launch_service``: a way to end the launch early."""
+
+    def __init__(self, supervisor: Supervisor) -> None:
+        self._supervisor = supervisor
+
+    def shutdown(self) -> None:
+        """Stop the launched processes (from any thread)."""
+        self._supervisor.request_shutdown("shutdown requested by a test")
+
+
+class LaunchTestRunner:
+    """Runs one TestRun with rosl's supervisor; prints unittest's verbose results."""
+
+    def __init__(
+        self,
+        test_run: TestRun,
+        arguments: dict[str, str] | None = None,
+        *,
+        stream: IO[str] | None = None,
+    ) -> None:
+        from rosl.launch.supervisor import Supervisor
+
+        self.test_run = test_run
+        self.arguments = dict(arguments or {})
+        self.stream = stream
+        self.supervisor = Supervisor()
+        self.supervisor.keep_alive = bool(test_run.markers.get("keep_alive", False))
+        self.proc_info = ActiveProcInfoHandler()
+        self.proc_output = ActiveIoHandler()
+        self._ready = threading.Event()
+        self._abandoned = False  # the launch failed before the tests could start
+        self._completed = threading.Event()
+        self._active: unittest.TestResult | None = None
+        self._thread = threading.Thread(target=self._run_active, name="launch_test", daemon=True)
+
+    def run(self) -> RunResult:
+        """Launch, run the active tests, shut down, run the post-shutdown tests.
+
+        Raises:
+            LaunchError: the test description or a launch action is wrong (nothing is left
+                running).
+            unittest.SkipTest: generate_test_description is skipped.
+        """
+        description, values = self.test_run.describe(self._ready.set)
+        self._bind(values)
+        self.supervisor.watchers.append(self._watch)
+        self.supervisor.install_signal_handlers()
+        try:
+            self._launch(description)
+        finally:
+            self.supervisor.restore_signal_handlers()
+        result = RunResult(interrupted=self.supervisor.interrupted)
+        if not self._completed.is_set():
+            result.problem = DIED
+            self._print(DIED)
+            self._print_failed_processes()
+            return result
+        assert self._active is not None
+        result.results.append(self._active)
+        result.results.append(self._unittest(self.test_run.post_shutdown_tests))
+        return result
+
+    def _launch(self, description: Any) -> None:
+        from rosl.launch.context import LaunchContext
+        from rosl.launch.description import check_required_arguments, process
+
+        supervisor = self.supervisor
+        supervisor.log("INFO", "launch", f"All log files can be found below {supervisor.log_dir}")
+        supervisor.log("INFO", "launch", "Default logging verbosity is set to INFO")
+        context = LaunchContext(supervisor, self.arguments)
+        context.files.append(self.test_run.path)
+        self._thread.start()
+        try:
+            check_required_arguments(description, context, self.test_run.path)
+            process(description.entities, context)
+        except BaseException:
+            self._abandoned = True
+            self._ready.set()
+            supervisor.shutdown("the launch description failed")
+            supervisor.run()
+            raise
+        supervisor.run()
+
+    def _bind(self, values: dict[str, Any]) -> None:
+        common = {**values, "test_args": dict(self.arguments)}
+        self.test_run.bind(self.test_run.pre_shutdown_tests, {
+            **common, "proc_info": self.proc_info, "proc_output": self.proc_output,
+            "launch_service": LaunchServiceHandle(self.supervisor),
+        })  # fmt: skip
+        self.test_run.bind(self.test_run.post_shutdown_tests, {
+            **common, "proc_info": self.proc_info._proc_info_handler,
+            "proc_output": self.proc_output._io_handler,
+        })  # fmt: skip
+
+    def _watch(self, event: ProcessEvent) -> None:  # on the supervising thread
+        if event.kind in ("stdout", "stderr"):
+            text = (event.text + "\n").encode()
+            fd = 1 if event.kind == "stdout" else 2
+            self.proc_output.append(ProcessIO(event.action, event.name, event.pid, text, fd))
+            return
+        details = {"name": event.name, "cmd": list(event.cmd), "pid": event.pid}
+        if event.kind == "start":
+            self.proc_output.track(event.action, details)
+            self.proc_info.append(ProcessStarted(event.action, event.name, event.pid, event.cmd))
+            with contextlib.suppress(AttributeError):  # as launch's ExecuteProcess has it
+                event.action.process_details = details
+        elif event.kind == "exit":
+            code = event.returncode if event.returncode is not None else -1
+            exited = ProcessExited(event.action, event.name, event.pid, event.cmd, code)
+            self.proc_info.append(exited)
+
+    def _run_active(self) -> None:  # the test thread
+        if not self._ready.wait(self.test_run.timeout):
+            self._print("Timed out waiting for processes to start up")
+            self.supervisor.request_shutdown("ReadyToTest did not run in time")
+            return
+        if self._abandoned:
+            return
+        try:
+            self._active = self._unittest(self.test_run.pre_shutdown_tests)
+        finally:
+            self._completed.set()
+            self.supervisor.request_shutdown("the active tests have finished")
+
+    def _unittest(self, suite: unittest.TestSuite) -> unittest.TestResult:
+        runner = unittest.TextTestRunner(stream=self.stream or sys.stderr, verbosity=2)
+        return runner.run(suite)
+
+    def _print(self, text: str) -> None:
+        print(text, file=self.stream or sys.stdout, flush=True)
+
+    def _print_failed_processes(self) -> None:
+        for info in self.proc_info:
+            if not isinstance(info, ProcessExited) or info.returncode == 0:
+                continue
+            self._print(f"Process '{info.process_name}' exited with {info.returncode}")
+            banner = f"##### '{info.process_name}' output #####"
+            self._print(banner)
+            try:
+                lines = self.proc_output[info.action]
+            except KeyError:
+                lines = []
+            for io in lines:
+                self._print(io.text.decode("utf-8", "replace").rstrip("\n"))
+            self._print("#" * len(banner))
