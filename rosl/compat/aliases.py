@@ -22,6 +22,7 @@ ALIASES: dict[str, str] = {
     "launch": "rosl.compat.launch",
     "launch_ros": "rosl.compat.launch_ros",
     "launch_testing": "rosl.compat.launch_testing",
+    "launch_testing_ros": "rosl.compat.launch_testing_ros",
     "ament_index_python": "rosl.compat.ament_index_python",
 }
 

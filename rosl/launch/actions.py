@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import shlex
+import shutil
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,6 +31,8 @@ if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
 
 DEFAULT_DESCRIPTION = "no description given"
+# where no `ros2` is installed, a launch file's `ros2 ...` command runs rosl's same words
+ROS2 = [sys.executable, "-m", "rosl"]
 
 
 class DeclareLaunchArgument(Action):
@@ -311,8 +315,10 @@ class ExecuteProcess(Action):
                 argv += part.command(context)
             else:
                 argv.append(perform(context, part))
+        if argv and argv[0] == "ros2" and shutil.which("ros2") is None:
+            argv = [*ROS2, *argv[1:]]  # `ros2 bag record ...` in a launch file: rosl's words
         if self.shell:
-            return ["/bin/sh", "-c", " ".join(argv)]
+            return ["/bin/sh", "-c", " ".join(shlex.quote(a) if a in ROS2 else a for a in argv)]
         return argv
 
     def base_name(self, context: LaunchContext, argv: list[str]) -> str:
@@ -322,6 +328,8 @@ class ExecuteProcess(Action):
         first = self.cmd[0] if isinstance(self.cmd, list) and self.cmd else self.cmd
         if isinstance(first, ExecutableInPackage):  # its file's name, even for a Python entry
             return perform(context, first.executable)
+        if argv[: len(ROS2)] == ROS2:
+            return "ros2"
         return os.path.basename(argv[0]) if argv else "process"
 
     def environment(self, context: LaunchContext) -> dict[str, str]:

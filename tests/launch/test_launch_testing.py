@@ -368,3 +368,75 @@ def test_only_files_marking_generate_test_description_are_launch_tests(launch_di
     assert is_launch_test(marked)
     assert not is_launch_test(unmarked)
     assert not [p for p in (REPO / "tests").rglob("test_*.py") if is_launch_test(p)]
+
+
+ROS_STYLE = """
+import shutil
+import tempfile
+import unittest
+from pathlib import Path
+
+import launch
+import launch_ros.actions
+import launch_testing
+import launch_testing.actions
+import launch_testing.asserts
+import pytest
+from launch_testing_ros import WaitForTopics
+from std_msgs.msg import String
+
+BAG = Path(tempfile.mkdtemp()) / "run"
+
+
+@pytest.mark.launch_test
+def generate_test_description():
+    talker = launch_ros.actions.Node(
+        package="launch_testing_example", executable="talker", output="screen",
+        parameters=[{"count": 1000}],
+    )
+    record = launch.actions.ExecuteProcess(
+        cmd=["ros2", "bag", "record", "/chatter", "-o", str(BAG)], output="screen"
+    )
+    hello = launch.actions.ExecuteProcess(cmd=["echo", "hello_world"], output="screen")
+    return launch.LaunchDescription([
+        record, talker, hello, launch_testing.actions.ReadyToTest(),
+    ]), {"record": record, "hello": hello}
+
+
+class TestAsRos2ExamplesDo(unittest.TestCase):
+    def test_the_talker_publishes(self):
+        with WaitForTopics([("chatter", String)], timeout=20.0) as wait_for_topics:
+            self.assertEqual(wait_for_topics.topics_received(), {"chatter"})
+            self.assertTrue(wait_for_topics.received_messages("chatter")[0].data)
+
+    def test_echo_says_hello(self, proc_output, hello):
+        proc_output.assertWaitFor("hello_world", process=hello, timeout=10, stream="stdout")
+
+    def test_the_recorder_subscribed(self, proc_output, record):
+        proc_output.assertWaitFor("Subscribed to topic '/chatter'", process=record, timeout=20)
+
+
+@launch_testing.post_shutdown_test()
+class TestAfter(unittest.TestCase):
+    def test_every_process_ended_well(self, proc_info):
+        launch_testing.asserts.assertExitCodes(proc_info, allowable_exit_codes=[0, -2, 130])
+
+    def test_the_bag_holds_chatter(self):
+        text = (BAG / "metadata.yaml").read_text()
+        self.assertIn("name: /chatter", text)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(BAG.parent, ignore_errors=True)
+"""
+
+
+def test_a_launch_test_in_ros2_examples_style_waits_for_topics_and_records_with_ros2_bag(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    # launch_testing_ros.WaitForTopics, `ros2 bag record` in an ExecuteProcess (rosl's words where
+    # no ros2 is installed) and echo, as ros2/examples' launch_testing_examples use them
+    path = write_launch(launch_dir, "test_ros_style.launch.py", ROS_STYLE)
+    code, out, err = rosl.run("launch_test", str(path), timeout=120.0)
+    assert code == 0, out + err
+    assert re.search(r"Ran 3 tests in .*\n\nOK", out + err), out + err
