@@ -307,7 +307,16 @@ class ExecuteProcess(Action):
         del log_cmd
 
     def command(self, context: LaunchContext) -> list[str]:
-        """The resolved command line."""
+        """The resolved command line (``/bin/sh -c ...`` with ``shell``)."""
+        return self._wrapped(self.words(context))
+
+    def _wrapped(self, argv: list[str]) -> list[str]:
+        if self.shell:
+            return ["/bin/sh", "-c", " ".join(shlex.quote(a) if a in ROS2 else a for a in argv)]
+        return argv
+
+    def words(self, context: LaunchContext) -> list[str]:
+        """The command's words as given, resolved (not yet handed to a shell)."""
         parts = self.cmd if isinstance(self.cmd, list) else [self.cmd]
         argv: list[str] = []
         for part in parts:  # a package's executable may be a Python entry: its whole argv
@@ -317,8 +326,6 @@ class ExecuteProcess(Action):
                 argv.append(perform(context, part))
         if argv and argv[0] == "ros2" and shutil.which("ros2") is None:
             argv = [*ROS2, *argv[1:]]  # `ros2 bag record ...` in a launch file: rosl's words
-        if self.shell:
-            return ["/bin/sh", "-c", " ".join(shlex.quote(a) if a in ROS2 else a for a in argv)]
         return argv
 
     def base_name(self, context: LaunchContext, argv: list[str]) -> str:
@@ -346,10 +353,14 @@ class ExecuteProcess(Action):
         """Hand the process to the supervisor."""
         from rosl.launch.supervisor import ProcessSpec
 
-        argv = self.command(context)
+        if self.shell:  # named after its command, not after the shell (substituted once)
+            words = self.words(context)
+            argv = self._wrapped(words)
+        else:
+            argv = words = self.command(context)
         prefix = perform(context, self.prefix) if self.prefix is not None else ""
         spec = ProcessSpec(
-            name=self.base_name(context, argv),
+            name=self.base_name(context, words),
             cmd=[*shlex.split(prefix), *argv],
             env=self.environment(context),
             cwd=perform(context, self.cwd) if self.cwd is not None else None,
@@ -399,11 +410,17 @@ class TimerAction(Action):
 
     def execute(self, context: LaunchContext) -> None:
         """Schedule the actions."""
-        seconds = (
-            float(perform(context, self.period))
+        text = (
+            perform(context, self.period)
             if not isinstance(self.period, (int, float))
-            else self.period
+            else str(self.period)
         )
+        try:
+            seconds = float(text)
+        except ValueError:
+            seconds = -1.0
+        if not seconds >= 0:  # (NaN too)
+            raise LaunchError(f"a timer's period must be a number of seconds >= 0, not '{text}'")
         if context.supervisor is not None:
             context.supervisor.call_later(seconds, lambda: process(self.actions, context))
 

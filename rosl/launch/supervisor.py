@@ -146,6 +146,7 @@ class Supervisor:
         self._watch: tuple[str, str] | None = None
         self._seen = False
         self.watchers: list[Callable[[ProcessEvent], None]] = []  # see every launched process
+        self._started: list[tuple[ProcessEvent, LaunchContext]] = []  # for the handlers, next
         self.keep_alive = False  # run() goes on after the last process, until a shutdown
         self._requests: list[str] = []  # shutdowns asked for by other threads
 
@@ -242,8 +243,8 @@ class Supervisor:
         self.log("INFO", label, f"process started with pid [{popen.pid}]")
         started = ProcessEvent("start", action, label, popen.pid, None, spec.cmd)
         self._notify(running, started)
-        if context is not None:
-            self._emit(started, context)
+        if context is not None:  # handlers see it from the loop, as launch's event queue has it:
+            self._started.append((started, context))  # also those registered after the action
         return label
 
     def wait_for_line(self, label: str, text: str, timeout: float) -> bool:
@@ -408,6 +409,9 @@ class Supervisor:
 
     def _step(self) -> None:
         self._handle_signals()
+        while self._started:  # start events, once what started them has been processed
+            event, where = self._started.pop(0)
+            self._emit(event, where)
         now = time.monotonic()
         wait = 0.1
         if self._timers:

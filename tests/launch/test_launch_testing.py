@@ -440,3 +440,37 @@ def test_a_launch_test_in_ros2_examples_style_waits_for_topics_and_records_with_
     code, out, err = rosl.run("launch_test", str(path), timeout=120.0)
     assert code == 0, out + err
     assert re.search(r"Ran 3 tests in .*\n\nOK", out + err), out + err
+
+
+ONLY_AFTER = """
+import unittest
+
+import launch
+import launch_testing
+import launch_testing.actions
+import launch_testing.asserts
+import pytest
+
+
+@pytest.mark.launch_test
+def generate_test_description():
+    return launch.LaunchDescription([
+        launch.actions.ExecuteProcess(cmd=["echo", "from_a"], output="screen"),
+        launch_testing.actions.ReadyToTest(),
+    ])
+
+
+@launch_testing.post_shutdown_test()
+class TestAfter(unittest.TestCase):
+    def test_exit_codes(self, proc_info):
+        launch_testing.asserts.assertExitCodes(proc_info)
+"""
+
+
+def test_a_launch_test_with_only_post_shutdown_tests_passes_however_fast_its_process_ends(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    path = write_launch(launch_dir, "test_only_after.launch.py", ONLY_AFTER)
+    for _ in range(3):  # the echo ends at once: the run must not outrun the (empty) active tests
+        code, out, err = rosl.run("launch_test", str(path))
+        assert code == 0, out + err

@@ -347,3 +347,52 @@ def test_unset_environment_variable_and_on_shutdown_work_as_in_launch(
     text = out + err
     assert "ROSL_TEST_A=<unset>" in text, text
     assert "shutting down: all processes have finished" in text, text
+
+
+HANDLER_AFTER = """
+import sys
+
+import launch
+
+
+def generate_launch_description():
+    worker = launch.actions.ExecuteProcess(
+        cmd=["echo", "hello_world"], shell=True, output="screen"
+    )
+    return launch.LaunchDescription([
+        worker,  # registered after its target, as the event-handler tutorial writes it
+        launch.actions.RegisterEventHandler(
+            launch.event_handlers.OnProcessStart(
+                target_action=worker, on_start=[launch.actions.LogInfo(msg="worker is up")]
+            )
+        ),
+    ])
+"""
+
+
+def test_a_handler_registered_after_its_action_sees_it_start_and_a_shell_is_named_by_its_command(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    path = write_launch(launch_dir, "after.launch.py", HANDLER_AFTER)
+    code, out, err = rosl.run("launch", str(path))
+    assert code == 0, f"{out}\n{err}"
+    text = out + err
+    assert "[launch.user]: worker is up" in text, text
+    assert "[echo-1] hello_world" in text, text  # echo-1, not sh-1
+
+
+def test_a_bad_timer_period_is_one_line(rosl: Rosl, launch_dir: Path) -> None:
+    path = write_launch(
+        launch_dir,
+        "timer.launch.xml",
+        """
+        <launch>
+          <timer period="abc"><log message="never"/></timer>
+        </launch>
+        """,
+    )
+    code, out, err = rosl.run("launch", str(path))
+    assert code == 1, f"{out}\n{err}"
+    line = one_error_line(err)
+    assert line.startswith(f"{path}:2: "), line
+    assert "a timer's period must be a number of seconds >= 0, not 'abc'" in line

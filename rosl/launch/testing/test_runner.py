@@ -104,6 +104,8 @@ class LaunchTestRunner:
         finally:
             self.supervisor.restore_signal_handlers()
         result = RunResult(interrupted=self.supervisor.interrupted)
+        if self._ready.is_set() and not self.test_run.pre_shutdown_tests.countTestCases():
+            self._thread.join(timeout=10.0)  # no active test: the (empty) run cannot be late
         if not self._completed.is_set():
             result.problem = DIED
             self._print(DIED)

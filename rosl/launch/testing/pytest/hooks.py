@@ -95,22 +95,24 @@ class LaunchTestModule(pytest.File):
             TestRun(module, self.path)
         except LaunchError as err:
             raise self.CollectError(str(err)) from None
-        return [LaunchTestItem.from_parent(self, name=module.__name__)]
+        item = LaunchTestItem.from_parent(self, name=module.__name__)
+        item.module = module  # its own: two files of one name in two folders stay apart
+        return [item]
 
 
 class LaunchTestItem(pytest.Item):
     """Runs one launch test file's launch and tests."""
 
+    module: Any = None  # the test file's module, loaded at collection
+
     def runtest(self) -> None:
         """Launch and test; raise LaunchTestFailure when something failed."""
-        import sys
-
         from rosl.launch.loader import parse_arguments
         from rosl.launch.testing.loader import TestRun
         from rosl.launch.testing.test_runner import LaunchTestRunner
 
         given = [text for group in self.config.getoption("--launch-args") or [] for text in group]
-        test_run = TestRun(sys.modules[self.name], self.path)  # fresh test cases every run
+        test_run = TestRun(self.module, self.path)  # fresh test cases every run
         result = LaunchTestRunner(test_run, parse_arguments(given)).run()
         if result.interrupted:
             raise KeyboardInterrupt
