@@ -23,6 +23,8 @@ ALIASES: dict[str, str] = {
     "launch_ros": "rosl.compat.launch_ros",
     "launch_testing": "rosl.compat.launch_testing",
     "launch_testing_ros": "rosl.compat.launch_testing_ros",
+    "launch_xml": "rosl.compat.launch_xml",
+    "launch_yaml": "rosl.compat.launch_yaml",
     "ament_index_python": "rosl.compat.ament_index_python",
 }
 

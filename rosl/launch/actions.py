@@ -264,6 +264,7 @@ class PythonLaunchDescriptionSource:
 AnyLaunchDescriptionSource = PythonLaunchDescriptionSource
 FrontendLaunchDescriptionSource = PythonLaunchDescriptionSource
 YAMLLaunchDescriptionSource = PythonLaunchDescriptionSource
+XMLLaunchDescriptionSource = PythonLaunchDescriptionSource  # the file's suffix decides
 
 
 class ExecuteProcess(Action):

@@ -148,37 +148,54 @@ class Node(ExecuteProcess):
         return "/" + joined if joined else ""
 
     def _parameter_arguments(self, context: LaunchContext) -> tuple[list[str], dict[str, Any]]:
-        values: dict[str, Any] = {}
+        """``--params-file`` arguments in the order the parameters were given (later wins).
+
+        Inline values (and SetParameter's, first) go to a file the launcher writes, one per run
+        of consecutive dicts, in their place among the user's files. ``--print`` shows them as
+        ``-p`` (no file is written for a dry run).
+        """
+        values: dict[str, Any] = {}  # every inline value (what --print and the details show)
+        steps: list[dict[str, Any] | str] = []  # inline groups and user files, in order
+        group: dict[str, Any] = {}
         for name, value in context.scope.parameters:
-            values[perform(context, name)] = parameter_value(context, value)
-        files: list[str] = []
+            group[perform(context, name)] = parameter_value(context, value)
         for entry in self.parameters:
             if isinstance(entry, dict):
                 for key, value in entry.items():
-                    values[perform(context, key)] = parameter_value(context, value)
+                    group[perform(context, key)] = parameter_value(context, value)
             elif isinstance(entry, (str, Path, Substitution, list, tuple, ParameterFile)):
                 path = _parameter_file(context, entry)
                 if not path.is_file():
                     raise LaunchError(
                         f"parameter file {path} (for {self._label(context)}) does not exist"
                     )
-                files.append(str(path))
+                if group:
+                    steps.append(group)
+                    group = {}
+                steps.append(str(path))
             else:
                 raise LaunchError(
                     f"parameters of {self._label(context)} must be dicts or YAML file paths, "
                     f"not {type(entry).__name__}"
                 )
+        if group:
+            steps.append(group)
+        for step in steps:
+            if isinstance(step, dict):
+                values.update(step)
+        supervisor = context.supervisor
         args: list[str] = []
-        if values and context.supervisor is not None and context.supervisor.dry_run:
+        if supervisor is not None and supervisor.dry_run:
             for key, value in values.items():  # --print: a command line that runs as printed
                 args += ["-p", f"{key}:={_yaml_value(value)}"]
-        elif values and context.supervisor is not None:
-            args += [
-                "--params-file",
-                str(context.supervisor.parameter_file(self._label(context), values)),
-            ]
-        for params_file in files:
-            args += ["--params-file", params_file]
+            for step in steps:
+                if isinstance(step, str):
+                    args += ["--params-file", step]
+        elif supervisor is not None:
+            for step in steps:
+                if isinstance(step, dict):
+                    step = str(supervisor.parameter_file(self._label(context), step))
+                args += ["--params-file", step]
         return args, values
 
     def _label(self, context: LaunchContext) -> str:

@@ -396,3 +396,40 @@ def test_a_bad_timer_period_is_one_line(rosl: Rosl, launch_dir: Path) -> None:
     line = one_error_line(err)
     assert line.startswith(f"{path}:2: "), line
     assert "a timer's period must be a number of seconds >= 0, not 'abc'" in line
+
+
+def test_parameters_apply_in_the_order_given_and_xml_sources_include(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    (launch_dir / "slow.yaml").write_text("/**:\n  ros__parameters:\n    timer_period_s: 3.0\n")
+    write_launch(
+        launch_dir,
+        "order.launch.xml",
+        """
+        <launch>
+          <node pkg="tutorial_pkg" exec="timer_node" name="ordered">
+            <param from="$(dirname)/slow.yaml"/>
+            <param name="timer_period_s" value="0.5"/>
+          </node>
+        </launch>
+        """,
+    )
+    parent = write_launch(
+        launch_dir,
+        "parent.launch.py",
+        """
+        import os
+
+        from launch import LaunchDescription
+        from launch.actions import IncludeLaunchDescription
+        from launch_xml.launch_description_sources import XMLLaunchDescriptionSource
+
+
+        def generate_launch_description():
+            child = os.path.join(os.path.dirname(__file__), "order.launch.xml")
+            return LaunchDescription([IncludeLaunchDescription(XMLLaunchDescriptionSource(child))])
+        """,
+    )
+    launch = rosl.start("launch", str(parent))
+    assert launch.wait_for(r"Timer period: 0\.5 s", "out", timeout=30.0), launch.both()
+    assert launch.interrupt() == 0, launch.both()
