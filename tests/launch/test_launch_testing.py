@@ -8,6 +8,7 @@ asserts and process lookup are checked on recorded output without launching anyt
 from __future__ import annotations
 
 import importlib.metadata
+import os
 import re
 import sys
 import threading
@@ -474,3 +475,32 @@ def test_a_launch_test_with_only_post_shutdown_tests_passes_however_fast_its_pro
     for _ in range(3):  # the echo ends at once: the run must not outrun the (empty) active tests
         code, out, err = rosl.run("launch_test", str(path))
         assert code == 0, out + err
+
+
+def test_a_ros2_launch_testing_plugin_installed_beside_makes_rosl_step_aside(
+    tmp_path: Path,
+) -> None:
+    import subprocess
+
+    site = tmp_path / "site"
+    info = site / "ros2_launch_testing-1.0.dist-info"  # ROS 2's plugin, as a sourced ROS 2 has it
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text(
+        "Metadata-Version: 2.1\nName: ros2-launch-testing\nVersion: 1.0\n"
+    )
+    (info / "entry_points.txt").write_text("[pytest11]\nlaunch_testing = fake_ros2_plugin\n")
+    (site / "fake_ros2_plugin.py").write_text(
+        "def pytest_addoption(parser):\n"
+        "    parser.addoption('--launch-args', action='append', nargs='*', default=[])\n"
+    )
+    (tmp_path / "test_plain.py").write_text("def test_plain():\n    assert True\n")
+    run = (  # its folder after rosl's on the path: rosl's plugin registers first
+        f"import sys; sys.path.append({str(site)!r}); import pytest; "
+        "sys.exit(pytest.main(['-q', '-p', 'no:cacheprovider', 'test_plain.py']))"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", run], cwd=tmp_path, env=dict(os.environ),
+        capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "1 passed" in result.stdout

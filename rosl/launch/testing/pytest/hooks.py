@@ -7,7 +7,9 @@ with its traceback. Launch arguments: ``--launch-args name:=value ...``.
 
 The plugin is loaded by every pytest session of an environment where rosl is installed, so it
 decides from the file's syntax tree alone (never importing it) and imports nothing heavy until
-it meets a launch test.
+it meets a launch test. Where ROS 2's own launch_testing is installed too (a sourced ROS 2),
+this plugin steps aside and leaves launch tests to it: two plugins adding one option would
+stop every pytest run.
 """
 
 from __future__ import annotations
@@ -24,8 +26,23 @@ if TYPE_CHECKING:
 MARK = "launch_test"
 
 
+def _ros2_plugin_installed() -> bool:
+    """Whether another pytest plugin named launch_testing (ROS 2's) is installed."""
+    import importlib.metadata
+
+    return any(
+        entry.name == "launch_testing" and not entry.value.startswith("rosl.")
+        for entry in importlib.metadata.entry_points(group="pytest11")
+    )
+
+
+STEP_ASIDE = _ros2_plugin_installed()
+
+
 def pytest_addoption(parser: pytest.Parser) -> None:
     """``--launch-args``."""
+    if STEP_ASIDE:
+        return
     with contextlib.suppress(ValueError):  # a real launch_testing's plugin added it already
         parser.addoption(
             "--launch-args",
@@ -68,7 +85,7 @@ def is_launch_test(path: Path) -> bool:
 @pytest.hookimpl(tryfirst=True)
 def pytest_pycollect_makemodule(module_path: Path, parent: pytest.Collector) -> Any:
     """Collect a launch test file as one LaunchTestModule; leave other files to pytest."""
-    if module_path.suffix == ".py" and is_launch_test(module_path):
+    if not STEP_ASIDE and module_path.suffix == ".py" and is_launch_test(module_path):
         return LaunchTestModule.from_parent(parent, path=module_path)
     return None
 
