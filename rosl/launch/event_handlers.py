@@ -32,6 +32,11 @@ class ProcessIO:
     cmd: list[str] = field(default_factory=list)
 
     @property
+    def process_name(self) -> str:
+        """The process's label (``talker-1``), as launch's ProcessIO names it."""
+        return self.name
+
+    @property
     def from_stdout(self) -> bool:
         """Printed on stdout."""
         return self.fd == 1

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from rosl.launch.event_handlers import ProcessIO  # one class for handlers' and tests' lines
 from rosl.launch.testing.asserts import assertInStream
 from rosl.launch.testing.util import NoMatchingProcessException, resolveProcesses
 
@@ -13,27 +13,6 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
 __unittest = True  # unittest leaves this module's frames out of failure tracebacks
-
-
-@dataclass(frozen=True, slots=True)
-class ProcessIO:
-    """Text a process printed (launch.events.process.ProcessIO): one line, newline included."""
-
-    action: Any
-    process_name: str
-    pid: int
-    text: bytes
-    fd: int  # 1: stdout, 2: stderr
-
-    @property
-    def from_stdout(self) -> bool:
-        """Printed on stdout."""
-        return self.fd == 1
-
-    @property
-    def from_stderr(self) -> bool:
-        """Printed on stderr (where ROS 2 loggers write)."""
-        return self.fd == 2
 
 
 class IoHandler:
@@ -224,3 +203,6 @@ class ActiveIoHandler:
         if not lines:
             return f" (nothing was printed on {stream})"
         return "; the last lines:\n" + "\n".join(f"    {line}" for line in lines[-3:])
+
+
+__all__ = ["ActiveIoHandler", "IoHandler", "ProcessIO"]
