@@ -26,6 +26,8 @@ ALIASES: dict[str, str] = {
     "launch_xml": "rosl.compat.launch_xml",
     "launch_yaml": "rosl.compat.launch_yaml",
     "ament_index_python": "rosl.compat.ament_index_python",
+    "rosidl_runtime_py": "rosl.compat.rosidl_runtime_py",
+    "sensor_msgs_py": "rosl.compat.sensor_msgs_py",
 }
 
 

@@ -53,3 +53,11 @@ class InterfaceError(RoslError):
 
 class FieldError(InterfaceError, TypeError):
     """A message field that does not exist, or a value a field cannot hold."""
+
+
+class PointCloudError(InterfaceError, ValueError):
+    """A PointCloud2 whose fields, sizes or points do not fit together."""
+
+
+class NotAMessageError(InterfaceError, TypeError):
+    """Something used as a message (type) that is not one: a service, or a plain object."""

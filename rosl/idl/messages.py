@@ -14,6 +14,7 @@ how the CDR serializer reads and writes them: :func:`wire_view`). ``char`` is an
 
 from __future__ import annotations
 
+import array as py_array
 import keyword
 import operator
 from collections.abc import Callable, Mapping
@@ -109,7 +110,7 @@ def byte_array_coercer(ftype: FieldType, where: str) -> Callable[[Any], list[byt
             items = [to_byte(v, f"{where}[{i}]") for i, v in enumerate(value)]
         else:
             raise FieldError(f"{where}: expects a list of byte, got {_show(value)}")
-        _check_length(ftype, len(items), where)
+        check_length(ftype, len(items), where)
         return items
 
     return coerce
@@ -126,9 +127,12 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
         if value is None:
             return np.zeros(ftype.size if ftype.array is ArrayKind.FIXED else 0, dtype)
         if type(value) is np.ndarray and value.dtype == dtype and value.ndim == 1:
-            array = value
+            # a read-only array is a view into received bytes: keep a copy the user may change
+            array = value if value.flags.writeable else value.copy()
         elif eight_bit and isinstance(value, (bytes, bytearray, memoryview)):
-            array = np.frombuffer(bytes(value), dtype=dtype).copy()
+            array = np.frombuffer(value, dtype=np.uint8).astype(dtype)  # one copy, no loop
+        elif isinstance(value, py_array.array) and np.dtype(value.typecode) == dtype:
+            array = np.frombuffer(value, dtype=dtype).copy()  # rclpy's array.array, as is
         else:
             raw = np.asarray(value)
             if kinds == "iu" and raw.dtype.kind in "fO" and raw.ndim == 1 and raw.size:
@@ -153,7 +157,7 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
                         f"{where}: values must lie in {low} to {high} for {ftype.base}"
                     )
                 array = raw.astype(dtype)
-        _check_length(ftype, len(array), where)
+        check_length(ftype, len(array), where)
         return array
 
     return coerce
@@ -391,8 +395,13 @@ def _convert(message: Message, attr: str, ftype: FieldType, value: Any, where: s
             element = cls()
             fill(element, item, f"{where}[{i}]")
             items.append(element)
-        _check_length(ftype, len(items), where)
+        check_length(ftype, len(items), where)
         return items
+    return convert_primitive(ftype, value, where)
+
+
+def convert_primitive(ftype: FieldType, value: Any, where: str) -> Any:
+    """Convert a plain value for a primitive field (scalar or array), or raise a FieldError."""
     if ftype.base == "byte":
         if ftype.is_array:
             return byte_array_coercer(ftype, where)(value)
@@ -407,12 +416,13 @@ def _convert(message: Message, attr: str, ftype: FieldType, value: Any, where: s
     if ftype.is_array:
         if not isinstance(value, list):
             raise FieldError(f"{where}: expects a list of strings, got {_show(value)}")
-        _check_length(ftype, len(value), where)
+        check_length(ftype, len(value), where)
         return [convert_scalar(ftype.element(), v, f"{where}[{i}]") for i, v in enumerate(value)]
     return convert_scalar(ftype, value, where)
 
 
-def _check_length(ftype: FieldType, length: int, where: str) -> None:
+def check_length(ftype: FieldType, length: int, where: str) -> None:
+    """Raise a FieldError naming ``where`` when an array's length breaks its bound."""
     if ftype.array is ArrayKind.FIXED and length != ftype.size:
         raise FieldError(f"{where}: needs exactly {ftype.size} values, got {length}")
     if ftype.array is ArrayKind.BOUNDED and length > ftype.size:
@@ -465,7 +475,7 @@ def check_fields(message: Message, path: str = "") -> None:
             if ftype.is_array:
                 if not isinstance(value, (list, tuple)):
                     raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
-                _check_length(ftype, len(value), where)
+                check_length(ftype, len(value), where)
             for i, item in enumerate(values):
                 item_where = f"{where}[{i}]" if ftype.is_array else where
                 if not isinstance(item, Message) or item._fields != cls._fields:
@@ -474,7 +484,7 @@ def check_fields(message: Message, path: str = "") -> None:
         elif ftype.is_array and ftype.base in ("string", "byte"):
             if not isinstance(value, (list, tuple)):
                 raise FieldError(f"{where}: expects a list of {ftype.base}, got {_show(value)}")
-            _check_length(ftype, len(value), where)
+            check_length(ftype, len(value), where)
             for i, item in enumerate(value):
                 _check_scalar(ftype.element(), item, f"{where}[{i}]")
         elif not ftype.is_array:

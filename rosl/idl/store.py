@@ -84,12 +84,23 @@ class Store:
         Raises:
             FieldError: a field holds a value its type cannot carry; the error names it.
         """
+        return bytes(self.serialize_view(message))
+
+    def serialize_view(self, message: Message) -> memoryview:
+        """Serialize as :meth:`serialize` does, as a read-only view of the new buffer.
+
+        Saves the copy into ``bytes`` (a pass over every byte of a large message) where any
+        buffer will do: sockets, files, the bus.
+
+        Raises:
+            FieldError: a field holds a value its type cannot carry; the error names it.
+        """
         type_name = message.__msgtype__
         if type_name in self._checked:
             check_fields(message)
         try:
             wire = wire_view(message)  # byte fields as rosbags holds them
-            return bytes(self._typestore.serialize_cdr(wire, type_name, little_endian=True))
+            return self._typestore.serialize_cdr(wire, type_name, little_endian=True)
         except _SERIALIZE_ERRORS as err:
             check_fields(message)
             raise FieldError(f"cannot serialize {type_name}: {err}") from err
@@ -104,8 +115,10 @@ class Store:
         """
         try:
             # rosbags slices any buffer (its hints say bytes | memoryview), and it builds our
-            # classes: add() installed them
-            return cast("Message", self._typestore.deserialize_cdr(cast("bytes", data), type_name))
+            # classes: add() installed them. Immutable bytes are sliced through a view, not
+            # copied whole; the message's arrays copy what they keep (messages.array_coercer).
+            view = memoryview(data) if isinstance(data, bytes) else data
+            return cast("Message", self._typestore.deserialize_cdr(cast("bytes", view), type_name))
         except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
             raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
 

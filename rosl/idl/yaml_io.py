@@ -9,6 +9,7 @@ with ``...``, and ``--no-arr``/``--no-str`` placeholders such as
 from __future__ import annotations
 
 import sys
+from collections import OrderedDict
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -187,3 +188,21 @@ def parse_yaml_mapping(text: str | None, what: str = "values") -> Mapping[str, A
             f'the {what} must be a YAML mapping like "{{field: value}}", got: {text}'
         )
     return data
+
+
+def message_to_ordereddict(
+    message: Message,
+    *,
+    truncate_length: int | None = None,
+    no_arr: bool = False,
+    no_str: bool = False,
+) -> OrderedDict[str, Any]:
+    """:func:`message_to_ordered` as the ``OrderedDict`` rosidl_runtime_py returns."""
+    return OrderedDict(
+        message_to_ordered(message, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str)
+    )
+
+
+def message_slot_types(message: Message) -> OrderedDict[str, str]:
+    """Each field's name and its type as written in ROS (``float64[3]``), in field order."""
+    return OrderedDict(message.get_fields_and_field_types())

@@ -527,3 +527,40 @@ def _coerce(
         f"Wrong parameter type, parameter {{{name}}} is of type {{{declared.word}}}, "
         f"setting it to {{{given.word}}} is not allowed."
     )
+
+
+PARAMETER_SEPARATOR_STRING = "."  # between the parts of a nested name ("pid.kp")
+
+
+def parameter_value_to_python(parameter_value: Any) -> Any:
+    """The Python value of an rcl_interfaces/msg/ParameterValue (None when not set).
+
+    Raises:
+        InvalidParameterTypeException: its ``type`` is not a ParameterType.
+    """
+    try:
+        return value_from_msg(parameter_value)[1]
+    except ValueError:
+        raise InvalidParameterTypeException(
+            f"unexpected parameter type {parameter_value.type}"
+        ) from None
+
+
+def get_parameter_value(string_value: str) -> Any:
+    """An rcl_interfaces/msg/ParameterValue from text read as YAML (``ros2 param set``'s rule).
+
+    Booleans, integers, doubles and lists of one of them (or of strings) keep their type;
+    anything else, mixed lists and text that is not YAML stay the text itself.
+    """
+    import yaml
+
+    try:
+        value = yaml.safe_load(string_value)
+    except yaml.YAMLError:
+        value = string_value
+    if not isinstance(value, (bool, int, float, list)):
+        value = string_value
+    try:
+        return Parameter("", value=value).get_parameter_value()
+    except InvalidParameterValueException:
+        return Parameter("", value=string_value).get_parameter_value()

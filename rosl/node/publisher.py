@@ -52,7 +52,7 @@ class Publisher:
             self._writer.coalesce(participant.flusher(), DEFAULT_BYTES)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
-        self._history: collections.deque[tuple[int, int, bytes]] | None = (
+        self._history: collections.deque[tuple[int, int, bytes | memoryview]] | None = (
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
         )
         self.destroyed = False
@@ -66,13 +66,14 @@ class Publisher:
 
     def publish(self, msg: Message | bytes | bytearray | memoryview) -> None:
         """Send one message (or already-serialized CDR bytes); never blocks on subscribers."""
+        data: bytes | memoryview
         if isinstance(msg, (bytes, bytearray, memoryview)):
             data = bytes(msg)
         else:
             if getattr(msg, "__msgtype__", None) != self.type_name:
                 got = getattr(msg, "__msgtype__", type(msg).__name__)
                 raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
-            data = self._store.serialize(msg)
+            data = self._store.serialize_view(msg)  # no copy into bytes: any buffer sends
         seq = self._writer.send(data)
         if self._history is not None:
             self._history.append((seq, self._writer.sent, data))

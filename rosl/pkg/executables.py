@@ -21,6 +21,8 @@ def find_executable(package: str, name: str) -> Executable:
     for executable in pkg.executables:
         if executable.name == name:
             return executable
+    if pkg.setup_error:
+        raise PackageError(pkg.setup_error)
     names = [e.name for e in pkg.executables]
     module = pkg.path / package / f"{name}.py"
     if module.is_file():  # the seed's pain: written, but never registered

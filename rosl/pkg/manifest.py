@@ -17,7 +17,6 @@ statically.
 
 from __future__ import annotations
 
-import ast
 import configparser
 import contextlib
 import xml.etree.ElementTree as ET
@@ -27,6 +26,7 @@ from pathlib import Path
 
 from rosl.idl import search_path
 from rosl.idl.errors import InterfaceError
+from rosl.pkg import setup_py as setup_py_reader
 from rosl.pkg.errors import PackageError
 
 _DEPEND_TAGS = ("depend", "exec_depend", "build_depend", "buildtool_depend", "test_depend")
@@ -77,6 +77,7 @@ class Package:
     maintainers: tuple[str, ...] = ()
     dependencies: tuple[str, ...] = ()
     executables: tuple[Executable, ...] = field(default_factory=tuple)
+    setup_error: str = ""  # setup.py's console_scripts could not be read (file:line: why)
 
     @property
     def manifest(self) -> Path:
@@ -107,7 +108,10 @@ def load(location: search_path.PackageLocation) -> Package:
         Executable(location.name, e.get("name", "").strip(), (e.text or "").strip(), location.path)
         for e in root.iterfind("export/rosl/executable")
         if e.get("name") and e.text
-    ) or _setup_console_scripts(location)
+    )
+    setup_error = ""
+    if not executables:
+        executables, setup_error = _setup_console_scripts(location)
     return Package(
         name=location.name,
         path=location.path,
@@ -119,26 +123,26 @@ def load(location: search_path.PackageLocation) -> Package:
         maintainers=maintainers,
         dependencies=tuple(dict.fromkeys(deps)),
         executables=executables,
+        setup_error=setup_error,
     )
 
 
-def _setup_console_scripts(location: search_path.PackageLocation) -> tuple[Executable, ...]:
-    """Read ``console_scripts`` from an ament_python package's setup.py/setup.cfg."""
+def _setup_console_scripts(
+    location: search_path.PackageLocation,
+) -> tuple[tuple[Executable, ...], str]:
+    """``console_scripts`` of an ament_python package's setup.py/setup.cfg, and any error.
+
+    The error (setup.py that cannot be read without running it) is kept, not raised: the
+    package still lists, and running one of its executables reports it.
+    """
     found: list[str] = []
+    error = ""
     setup_py = location.path / "setup.py"
     if setup_py.is_file():
         try:
-            tree = ast.parse(setup_py.read_text(encoding="utf-8"))
-        except (SyntaxError, OSError, UnicodeDecodeError):
-            tree = None
-        for node in ast.walk(tree) if tree else ():
-            if isinstance(node, ast.Dict):
-                for key, value in zip(node.keys, node.values, strict=True):
-                    if isinstance(key, ast.Constant) and key.value == "console_scripts":
-                        try:
-                            found.extend(ast.literal_eval(value))
-                        except ValueError:
-                            continue
+            found.extend(setup_py_reader.console_scripts(setup_py))
+        except PackageError as err:
+            error = str(err)
     setup_cfg = location.path / "setup.cfg"
     if setup_cfg.is_file():
         parser = configparser.ConfigParser()
@@ -155,7 +159,7 @@ def _setup_console_scripts(location: search_path.PackageLocation) -> tuple[Execu
             executables.append(
                 Executable(location.name, name.strip(), entry.strip(), location.path)
             )
-    return tuple(executables)
+    return tuple(executables), error
 
 
 def declaration_site(package_path: Path, name: str, entry: str) -> str:

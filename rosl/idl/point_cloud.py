@@ -1,0 +1,249 @@
+"""sensor_msgs/msg/PointCloud2 as numpy: the operations of ROS 2's ``sensor_msgs_py``.
+
+A cloud's points are read as one structured numpy array laid over the message's bytes (its
+``PointField`` list gives names, types and offsets), and a cloud is built from a structured
+array, a plain 2-D array or a list of tuples with one copy — never a loop over points in
+Python, except for the list forms that ask for Python objects (``read_points_list``, a list
+given to ``create_cloud``). ``sensor_msgs_py.point_cloud2`` re-exports these names.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import namedtuple
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.lib import recfunctions
+
+from rosl.idl.errors import PointCloudError
+from rosl.idl.registry import get_message_class
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+__all__ = [
+    "DATATYPES",
+    "create_cloud",
+    "create_cloud_xyz32",
+    "dtype_from_fields",
+    "read_points",
+    "read_points_list",
+    "read_points_numpy",
+]
+
+# PointField.datatype -> numpy type (the constants INT8=1 ... FLOAT64=8)
+DATATYPES: dict[int, type[np.generic]] = {
+    1: np.int8,
+    2: np.uint8,
+    3: np.int16,
+    4: np.uint16,
+    5: np.int32,
+    6: np.uint32,
+    7: np.float32,
+    8: np.float64,
+}
+_CLOUD = "sensor_msgs/msg/PointCloud2"
+
+
+def dtype_from_fields(fields: Iterable[Any], point_step: int | None = None) -> np.dtype[Any]:
+    """Return the structured dtype of one point described by ``PointField`` messages.
+
+    A field without a name is called ``unnamed_field_<index>``; a ``count`` above 1 gives
+    that field a sub-array. ``point_step`` pads the dtype to the cloud's point size.
+
+    Raises:
+        PointCloudError: an unknown datatype, or two fields of one name.
+    """
+    names: list[str] = []
+    formats: list[Any] = []
+    offsets: list[int] = []
+    for index, field in enumerate(fields):
+        name = field.name or f"unnamed_field_{index}"
+        if name in names:
+            raise PointCloudError(f"PointCloud2: two fields are named '{name}'")
+        if field.datatype not in DATATYPES:
+            raise PointCloudError(
+                f"PointCloud2 field '{name}': datatype {field.datatype} is not one of "
+                "PointField's INT8 (1) to FLOAT64 (8)"
+            )
+        base = np.dtype(DATATYPES[field.datatype])
+        names.append(name)
+        formats.append(base if field.count <= 1 else (base, (int(field.count),)))
+        offsets.append(int(field.offset))
+    layout: dict[str, Any] = {"names": names, "formats": formats, "offsets": offsets}
+    if point_step is not None:
+        layout["itemsize"] = int(point_step)
+    try:
+        result: np.dtype[Any] = np.dtype(layout)  # type: ignore[call-overload]
+        return result
+    except ValueError as err:
+        raise PointCloudError(f"PointCloud2 fields do not fit in a point: {err}") from None
+
+
+def read_points(
+    cloud: Any,
+    field_names: Sequence[str] | None = None,
+    skip_nans: bool = False,
+    uvs: Iterable[Any] | None = None,
+    reshape_organized_cloud: bool = False,
+) -> np.ndarray[Any, Any]:
+    """Return a cloud's points as a structured numpy array (a view of its data: no copy).
+
+    Args:
+        cloud: a sensor_msgs/msg/PointCloud2.
+        field_names: the fields to keep (all when None).
+        skip_nans: drop points with a NaN in any kept field (unless the cloud says it is dense).
+        uvs: indices of the points to return.
+        reshape_organized_cloud: shape (height, width) when the cloud has several rows.
+
+    Raises:
+        PointCloudError: not a PointCloud2, unknown field names, or too few bytes.
+    """
+    if getattr(cloud, "__msgtype__", None) != _CLOUD:
+        raise PointCloudError(f"read_points expects a {_CLOUD}, got {type(cloud).__name__}")
+    dtype = dtype_from_fields(cloud.fields, cloud.point_step or None)
+    count = int(cloud.width) * int(cloud.height)
+    data = np.asarray(cloud.data, dtype=np.uint8)
+    if data.size < count * dtype.itemsize:
+        raise PointCloudError(
+            f"PointCloud2 holds {data.size} bytes of data, fewer than its {count} points of "
+            f"{dtype.itemsize} bytes each"
+        )
+    if cloud.row_step and cloud.height > 1 and cloud.row_step != cloud.width * dtype.itemsize:
+        rows = np.lib.stride_tricks.as_strided(
+            data, (int(cloud.height), int(cloud.width) * dtype.itemsize), (cloud.row_step, 1)
+        )
+        data = np.ascontiguousarray(rows).reshape(-1)  # rows with padding: one copy
+    points = np.frombuffer(data, dtype=dtype, count=count)
+    if field_names is not None:
+        missing = [n for n in field_names if n not in (dtype.names or ())]
+        if missing:
+            raise PointCloudError(
+                f"PointCloud2 has no field '{missing[0]}'; its fields are: "
+                + ", ".join(dtype.names or ())
+            )
+        points = points[list(field_names)]
+    if bool(cloud.is_bigendian) != (sys.byteorder == "big"):  # values in this machine's order
+        points = points.view(points.dtype.newbyteorder()).astype(points.dtype)
+    if skip_nans and not cloud.is_dense and len(points):
+        keep = np.ones(len(points), dtype=bool)
+        for name in points.dtype.names or ():
+            column = points[name]
+            if column.dtype.kind == "f":
+                bad = np.isnan(column)
+                keep &= ~(bad.reshape(len(points), -1).any(axis=1))
+        points = points[keep]
+    if uvs is not None:
+        index = uvs if isinstance(uvs, np.ndarray) else np.fromiter(uvs, dtype=np.int64)
+        points = points[index]
+    if reshape_organized_cloud and cloud.height > 1:
+        points = points.reshape(int(cloud.height), int(cloud.width))
+    return points
+
+
+def read_points_numpy(
+    cloud: Any,
+    field_names: Sequence[str] | None = None,
+    skip_nans: bool = False,
+    uvs: Iterable[Any] | None = None,
+    reshape_organized_cloud: bool = False,
+) -> np.ndarray[Any, Any]:
+    """Return the points as a plain 2-D array (one column per field; fields of one type).
+
+    Raises:
+        PointCloudError: the fields read have different datatypes.
+    """
+    wanted = [f for f in cloud.fields if field_names is None or f.name in field_names]
+    if len({f.datatype for f in wanted}) > 1:
+        raise PointCloudError(
+            "read_points_numpy needs fields of one datatype; use read_points for mixed ones"
+        )
+    points = read_points(cloud, field_names, skip_nans, uvs, reshape_organized_cloud)
+    return recfunctions.structured_to_unstructured(points)
+
+
+def read_points_list(
+    cloud: Any,
+    field_names: Sequence[str] | None = None,
+    skip_nans: bool = False,
+    uvs: Iterable[Any] | None = None,
+) -> list[Any]:
+    """Return the points as a list of namedtuples ``Point(x=..., y=..., ...)``."""
+    points = read_points(cloud, field_names, skip_nans, uvs)
+    factory: Any = namedtuple  # field names known only at run time
+    point = factory("Point", points.dtype.names or (), rename=True)
+    return [point._make(p) for p in points.tolist()]
+
+
+def create_cloud(
+    header: Any, fields: Sequence[Any], points: Any, point_step: int | None = None
+) -> Any:
+    """Build a sensor_msgs/msg/PointCloud2 from points.
+
+    Args:
+        header: the cloud's std_msgs/msg/Header.
+        fields: its sensor_msgs/msg/PointField list.
+        points: a structured array whose dtype matches ``fields``; a plain array of shape
+            (N, fields) or (rows, cols, fields) when all fields share one datatype; or an
+            iterable of per-point tuples. A 2-D structured array is an organized cloud.
+        point_step: bytes per point (default: the end of the last field).
+
+    Raises:
+        PointCloudError: points that do not match the fields.
+    """
+    dtype = dtype_from_fields(fields, point_step)
+    if isinstance(points, np.ndarray) and points.dtype.names is None:
+        kinds = {f.datatype for f in fields}
+        if len(kinds) != 1:
+            raise PointCloudError(
+                "create_cloud: a plain array needs fields of one datatype; "
+                "pass a structured array for mixed ones"
+            )
+        if points.ndim < 2 or points.shape[-1] != len(fields):
+            raise PointCloudError(
+                f"create_cloud: points of shape {points.shape} do not have one column for "
+                f"each of the {len(fields)} fields"
+            )
+        points = recfunctions.unstructured_to_structured(points, dtype=dtype)
+    elif isinstance(points, np.ndarray):
+        if points.dtype != dtype:
+            try:
+                points = points.astype(dtype, casting="same_kind")
+            except (TypeError, ValueError) as err:
+                raise PointCloudError(
+                    f"create_cloud: the points' fields {points.dtype.names} do not match the "
+                    f"PointFields {dtype.names} ({err})"
+                ) from None
+    else:
+        try:
+            points = np.array([tuple(p) for p in points], dtype=dtype)
+        except (TypeError, ValueError) as err:
+            raise PointCloudError(
+                f"create_cloud: the points do not match the fields ({err})"
+            ) from None
+    if points.ndim > 2:
+        raise PointCloudError("create_cloud: an organized cloud has at most two dimensions")
+    height, width = (1, len(points)) if points.ndim == 1 else points.shape
+    data = np.ascontiguousarray(points).view(np.uint8).reshape(-1)
+    if np.may_share_memory(data, points):
+        data = data.copy()  # the message owns its bytes, as in rclpy
+    cloud_class = get_message_class(_CLOUD)
+    return cloud_class(
+        header=header,
+        height=height,
+        width=width,
+        fields=list(fields),
+        is_bigendian=sys.byteorder != "little",
+        point_step=dtype.itemsize,
+        row_step=dtype.itemsize * width,
+        data=data,
+        is_dense=False,
+    )
+
+
+def create_cloud_xyz32(header: Any, points: Any) -> Any:
+    """Build a PointCloud2 of float32 ``x``, ``y``, ``z`` from (N, 3) points."""
+    field_class = get_message_class("sensor_msgs/msg/PointField")
+    fields = [field_class(name=n, offset=4 * i, datatype=7, count=1) for i, n in enumerate("xyz")]
+    return create_cloud(header, fields, np.asarray(points, dtype=np.float32).reshape(-1, 3))
