@@ -115,9 +115,14 @@ class Store:
         """
         try:
             # rosbags slices any buffer (its hints say bytes | memoryview), and it builds our
-            # classes: add() installed them. Immutable bytes are sliced through a view, not
-            # copied whole; the message's arrays copy what they keep (messages.array_coercer).
-            view = memoryview(data) if isinstance(data, bytes) else data
+            # classes: add() installed them. Its arrays are views into what it is given, so it
+            # gets a private copy (one memcpy): the arrays are then writable, as in rclpy, and
+            # no caller's buffer is aliased. A read-only view is used as is; the message's
+            # arrays copy what they keep from it (messages.array_coercer).
+            if isinstance(data, memoryview) and data.readonly:
+                view: memoryview = data
+            else:
+                view = memoryview(bytearray(data))
             return cast("Message", self._typestore.deserialize_cdr(cast("bytes", view), type_name))
         except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
             raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
