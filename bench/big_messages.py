@@ -77,7 +77,8 @@ def measure(name: str, message: Any, runs: int, repeat: int) -> dict[str, float]
     if bytes(theirs.serialize_cdr(their_message, type_name, little_endian=True)) != received:
         raise SystemExit(f"{name}: rosl and rosbags encode different bytes")
     decoded = ours.deserialize(received, type_name)
-    assert decoded == message and decoded.data.flags.writeable, name
+    if decoded != message or not decoded.data.flags.writeable:
+        raise SystemExit(f"{name}: rosl does not decode what it encoded")
     times: dict[str, list[float]] = {k: [] for k in ("ser", "de", "rb_ser", "rb_de")}
     for _ in range(runs):  # interleaved, so load on the machine hits both alike
         times["ser"].append(_per_call(repeat, lambda: ours.serialize_view(message)))
@@ -85,7 +86,9 @@ def measure(name: str, message: Any, runs: int, repeat: int) -> dict[str, float]
             _per_call(repeat, lambda: theirs.serialize_cdr(their_message, type_name))
         )
         times["de"].append(_per_call(repeat, lambda: ours.deserialize(received, type_name)))
-        times["rb_de"].append(_per_call(repeat, lambda: theirs.deserialize_cdr(received, type_name)))
+        times["rb_de"].append(
+            _per_call(repeat, lambda: theirs.deserialize_cdr(received, type_name))
+        )
     result = {k: statistics.median(v) for k, v in times.items()}
     result["size"] = len(received)
     return result

@@ -58,7 +58,7 @@ def test_set_message_fields_raises_the_kinds_upstream_raises() -> None:
     with pytest.raises(ValueError, match="out of range"):
         set_message_fields(Int32(), {"data": 2**40})
     with pytest.raises(
-        TypeError, match="^Value 'auto' is expected to be a dictionary but is a str$"
+        TypeError, match=r"^Value 'auto' is expected to be a dictionary but is a str$"
     ):
         set_message_fields(Header(), {"stamp": "auto"})
 
