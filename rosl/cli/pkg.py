@@ -90,6 +90,8 @@ def list_(verbose: bool) -> int:
 def executables(package_name: str | None, full_path: bool) -> None:
     """Output a list of package specific executables."""
     packages = [manifest.get_package(package_name)] if package_name else manifest.list_packages()
+    if package_name and packages[0].setup_error:
+        raise PackageError(packages[0].setup_error)
     rows = []
     for pkg in packages:
         for exe in sorted(pkg.executables, key=lambda e: e.name):

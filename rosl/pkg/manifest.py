@@ -181,6 +181,9 @@ def declaration_site(package_path: Path, name: str, entry: str) -> str:
         parser.Parse(manifest.read_bytes(), True)
     if name in lines:
         return f"{manifest}:{lines[name]}"
+    setup_lines = setup_py_reader.console_script_lines(package_path / "setup.py")
+    if name in setup_lines:  # also an entry built in code ('x = ' + package_name + ...)
+        return f"{package_path / 'setup.py'}:{setup_lines[name]}"
     for setup in (package_path / "setup.py", package_path / "setup.cfg"):
         try:
             text = setup.read_text(encoding="utf-8")

@@ -18,7 +18,7 @@ from rosl.pkg.errors import PackageError
 if TYPE_CHECKING:
     from pathlib import Path
 
-__all__ = ["console_scripts"]
+__all__ = ["console_script_lines", "console_scripts"]
 
 
 class _UnreadableError(Exception):
@@ -37,6 +37,19 @@ def console_scripts(path: Path) -> list[str]:
         PackageError: setup.py cannot be read or parsed, or its entry points cannot be
             evaluated without running it (``path:line: ...``).
     """
+    return [entry for entry, _ in _entries(path)]
+
+
+def console_script_lines(path: Path) -> dict[str, int]:
+    """Each executable's name and the setup.py line of its entry ({} when unreadable)."""
+    try:
+        entries = _entries(path)
+    except PackageError:
+        return {}
+    return {entry.partition("=")[0].strip(): line for entry, line in entries}
+
+
+def _entries(path: Path) -> list[tuple[str, int]]:
     try:
         text = path.read_text(encoding="utf-8")
         tree = ast.parse(text, filename=str(path))
@@ -85,7 +98,8 @@ class _Reader:
         ):
             self.names[statement.target.id] = statement.value
 
-    def console_scripts(self) -> list[str]:
+    def console_scripts(self) -> list[tuple[str, int]]:
+        """Each entry with the line of the expression that gives it."""
         entry_points = self._entry_points()
         if entry_points is None:
             return []
@@ -97,7 +111,29 @@ class _Reader:
             scripts = scripts.splitlines()
         if not isinstance(scripts, (list, tuple)) or not all(isinstance(s, str) for s in scripts):
             raise _UnreadableError(entry_points, "console_scripts is not a list of strings")
-        return [s for s in scripts if s.strip()]
+        lines = self._element_lines(entry_points)
+        if len(lines) != len(scripts):
+            lines = [entry_points.lineno] * len(scripts)
+        return [(s, line) for s, line in zip(scripts, lines, strict=True) if s.strip()]
+
+    def _element_lines(self, entry_points: ast.expr) -> list[int]:
+        """The line of each element of a literal console_scripts list (else [])."""
+        node = self._resolved(entry_points)
+        if not isinstance(node, ast.Dict):
+            return []
+        for key, value in zip(node.keys, node.values, strict=True):
+            if isinstance(key, ast.Constant) and key.value == "console_scripts":
+                found = self._resolved(value)
+                if isinstance(found, (ast.List, ast.Tuple)):
+                    return [element.lineno for element in found.elts]
+        return []
+
+    def _resolved(self, node: ast.expr) -> ast.expr:
+        seen: set[str] = set()
+        while isinstance(node, ast.Name) and node.id in self.names and node.id not in seen:
+            seen.add(node.id)
+            node = self.names[node.id]
+        return node
 
     def _entry_points(self) -> ast.expr | None:
         if self.setup is not None:

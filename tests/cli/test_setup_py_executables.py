@@ -106,3 +106,22 @@ def test_a_setup_py_with_a_syntax_error_is_one_line_with_its_line(
     folder = _package(make_package, SETUP_PY.replace("version='0.0.0',", "version='0.0.0',,"))
     assert_user_error(rosl("run", "calc_py", "server"), f"{folder / 'setup.py'}:11:")
     assert rosl("pkg", "list").code == 0  # the package still lists
+
+
+def test_an_entry_built_in_code_naming_a_missing_module_points_at_its_setup_py_line(
+    make_package: Callable[..., Path], workspace: Path, rosl_process: Callable[..., Result]
+) -> None:
+    folder = _package(make_package, SETUP_PY.replace("'.server:main'", "'.servr:main'"))
+    assert_user_error(
+        rosl_process("run", "calc_py", "server", cwd=workspace),
+        f"{folder / 'setup.py'}:19:",
+        "module 'calc_py.servr' not found",
+        "did you mean 'calc_py.server'",
+    )
+
+
+def test_pkg_executables_of_a_package_whose_setup_py_cannot_be_read_is_one_line(
+    make_package: Callable[..., Path], rosl: Callable[..., Result]
+) -> None:
+    folder = _package(make_package, SETUP_PY.replace("suffix: str = '_node'", "suffix = x()"))
+    assert_user_error(rosl("pkg", "executables", "calc_py"), f"{folder / 'setup.py'}:7:", "x()")
