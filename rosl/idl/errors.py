@@ -55,8 +55,11 @@ class FieldError(InterfaceError, TypeError):
     """A message field that does not exist, or a value a field cannot hold."""
 
 
-class PointCloudError(InterfaceError, ValueError):
-    """A PointCloud2 whose fields, sizes or points do not fit together."""
+class PointCloudError(InterfaceError, ValueError, AssertionError):
+    """A PointCloud2 whose fields, sizes or points do not fit together.
+
+    Also an ``AssertionError``: sensor_msgs_py asserts these, and code may catch that.
+    """
 
 
 class NotAMessageError(InterfaceError, TypeError):

@@ -49,36 +49,41 @@ _CLOUD = "sensor_msgs/msg/PointCloud2"
 def dtype_from_fields(fields: Iterable[Any], point_step: int | None = None) -> np.dtype[Any]:
     """Return the structured dtype of one point described by ``PointField`` messages.
 
-    A field without a name is called ``unnamed_field_<index>``; a ``count`` above 1 gives
-    that field a sub-array. ``point_step`` pads the dtype to the cloud's point size.
+    A field without a name is called ``unnamed_field_<index>``; a field of ``count`` N > 1
+    becomes N fields ``<name>_0`` ... ``<name>_<N-1>``, as sensor_msgs_py names them.
+    ``point_step`` pads the dtype to the cloud's point size.
 
     Raises:
-        PointCloudError: an unknown datatype, or two fields of one name.
+        PointCloudError: an unknown datatype, a count of 0, or two fields of one name.
     """
     names: list[str] = []
     formats: list[Any] = []
     offsets: list[int] = []
     for index, field in enumerate(fields):
         name = field.name or f"unnamed_field_{index}"
-        if name in names:
-            raise PointCloudError(f"PointCloud2: two fields are named '{name}'")
         if field.datatype not in DATATYPES:
             raise PointCloudError(
                 f"PointCloud2 field '{name}': datatype {field.datatype} is not one of "
                 "PointField's INT8 (1) to FLOAT64 (8)"
             )
+        if field.count < 1:
+            raise PointCloudError(f"PointCloud2 field '{name}': a count of 0 holds no value")
         base = np.dtype(DATATYPES[field.datatype])
-        names.append(name)
-        formats.append(base if field.count <= 1 else (base, (int(field.count),)))
-        offsets.append(int(field.offset))
+        for part in range(field.count):
+            part_name = f"{name}_{part}" if field.count > 1 else name
+            if part_name in names:
+                raise PointCloudError(f"PointCloud2: two fields are named '{part_name}'")
+            names.append(part_name)
+            formats.append(base)
+            offsets.append(int(field.offset) + part * base.itemsize)
     layout: dict[str, Any] = {"names": names, "formats": formats, "offsets": offsets}
     if point_step is not None:
         layout["itemsize"] = int(point_step)
     try:
         result: np.dtype[Any] = np.dtype(layout)  # type: ignore[call-overload]
-        return result
     except ValueError as err:
         raise PointCloudError(f"PointCloud2 fields do not fit in a point: {err}") from None
+    return result
 
 
 def read_points(
@@ -95,7 +100,8 @@ def read_points(
         field_names: the fields to keep (all when None).
         skip_nans: drop points with a NaN in any kept field (unless the cloud says it is dense).
         uvs: indices of the points to return.
-        reshape_organized_cloud: shape (height, width) when the cloud has several rows.
+        reshape_organized_cloud: shape (width, height) when the cloud has several rows, as
+            sensor_msgs_py shapes it (``create_cloud`` of an (a, b) array has width a).
 
     Raises:
         PointCloudError: not a PointCloud2, unknown field names, or too few bytes.
@@ -110,11 +116,6 @@ def read_points(
             f"PointCloud2 holds {data.size} bytes of data, fewer than its {count} points of "
             f"{dtype.itemsize} bytes each"
         )
-    if cloud.row_step and cloud.height > 1 and cloud.row_step != cloud.width * dtype.itemsize:
-        rows = np.lib.stride_tricks.as_strided(
-            data, (int(cloud.height), int(cloud.width) * dtype.itemsize), (cloud.row_step, 1)
-        )
-        data = np.ascontiguousarray(rows).reshape(-1)  # rows with padding: one copy
     points = np.frombuffer(data, dtype=dtype, count=count)
     if field_names is not None:
         missing = [n for n in field_names if n not in (dtype.names or ())]
@@ -131,14 +132,13 @@ def read_points(
         for name in points.dtype.names or ():
             column = points[name]
             if column.dtype.kind == "f":
-                bad = np.isnan(column)
-                keep &= ~(bad.reshape(len(points), -1).any(axis=1))
+                keep &= ~np.isnan(column)
         points = points[keep]
     if uvs is not None:
         index = uvs if isinstance(uvs, np.ndarray) else np.fromiter(uvs, dtype=np.int64)
         points = points[index]
     if reshape_organized_cloud and cloud.height > 1:
-        points = points.reshape(int(cloud.height), int(cloud.width))
+        points = points.reshape(int(cloud.width), int(cloud.height))
     return points
 
 
@@ -200,21 +200,19 @@ def create_cloud(
                 "create_cloud: a plain array needs fields of one datatype; "
                 "pass a structured array for mixed ones"
             )
-        if points.ndim < 2 or points.shape[-1] != len(fields):
+        columns = len(dtype.names or ())
+        if points.ndim < 2 or points.shape[-1] != columns:
             raise PointCloudError(
                 f"create_cloud: points of shape {points.shape} do not have one column for "
-                f"each of the {len(fields)} fields"
+                f"each of the {columns} values of a point"
             )
         points = recfunctions.unstructured_to_structured(points, dtype=dtype)
     elif isinstance(points, np.ndarray):
         if points.dtype != dtype:
-            try:
-                points = points.astype(dtype, casting="same_kind")
-            except (TypeError, ValueError) as err:
-                raise PointCloudError(
-                    f"create_cloud: the points' fields {points.dtype.names} do not match the "
-                    f"PointFields {dtype.names} ({err})"
-                ) from None
+            raise PointCloudError(
+                f"create_cloud: the points' dtype {points.dtype} does not match the PointFields' "
+                f"{dtype} (names, order, types and point_step must agree)"
+            )
     else:
         try:
             points = np.array([tuple(p) for p in points], dtype=dtype)
@@ -224,7 +222,7 @@ def create_cloud(
             ) from None
     if points.ndim > 2:
         raise PointCloudError("create_cloud: an organized cloud has at most two dimensions")
-    height, width = (1, len(points)) if points.ndim == 1 else points.shape
+    width, height = (len(points), 1) if points.ndim == 1 else points.shape  # sensor_msgs_py's
     data = np.ascontiguousarray(points).view(np.uint8).reshape(-1)
     if np.may_share_memory(data, points):
         data = data.copy()  # the message owns its bytes, as in rclpy
@@ -243,7 +241,8 @@ def create_cloud(
 
 
 def create_cloud_xyz32(header: Any, points: Any) -> Any:
-    """Build a PointCloud2 of float32 ``x``, ``y``, ``z`` from (N, 3) points."""
+    """Build a PointCloud2 of float32 ``x``, ``y``, ``z`` from (N, 3) or (width, height, 3)."""
     field_class = get_message_class("sensor_msgs/msg/PointField")
     fields = [field_class(name=n, offset=4 * i, datatype=7, count=1) for i, n in enumerate("xyz")]
-    return create_cloud(header, fields, np.asarray(points, dtype=np.float32).reshape(-1, 3))
+    values = np.asarray(points, dtype=np.float32)
+    return create_cloud(header, fields, values if values.ndim > 1 else values.reshape(-1, 3))
