@@ -3,8 +3,11 @@
 A generated class has ``__slots__`` and a compiled ``__init__`` taking every field by keyword
 or in field order (rosbags' deserializer calls ``cls(*values)``), so building a received
 message costs one Python call. Numeric arrays are numpy arrays of the field's dtype; they are
-properties that accept lists, tuples, ``bytes`` (for 8-bit types) and numpy arrays, and check
-fixed lengths and bounds on assignment. Scalars are plain attributes: a wrong value is found
+properties that accept lists, tuples, ``bytes``/``bytearray``/``memoryview`` (for 8-bit
+types), ``array.array`` and numpy arrays — whole, never element by element (a numpy array of
+the right dtype is kept as it is; a read-only one, a view into received bytes, is copied so
+that the message may be changed, as in rclpy) — and check fixed lengths and bounds on
+assignment. Scalars are plain attributes: a wrong value is found
 when the message is serialized (``store``), where ``check_fields`` names the field.
 
 ``byte`` is as rclpy has it: a ``bytes`` object of length 1 (``bytes([0])``), and a byte array is
