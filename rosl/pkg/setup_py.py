@@ -140,6 +140,16 @@ class _Reader:
             for keyword in self.setup.keywords:
                 if keyword.arg == "entry_points":
                     return keyword.value
+            for keyword in self.setup.keywords:  # setup(**options), options a dict or dict()
+                options = self._resolved(keyword.value) if keyword.arg is None else None
+                if isinstance(options, ast.Dict):
+                    for key, value in zip(options.keys, options.values, strict=True):
+                        if isinstance(key, ast.Constant) and key.value == "entry_points":
+                            return value
+                elif isinstance(options, ast.Call):
+                    for option in options.keywords:
+                        if option.arg == "entry_points":
+                            return option.value
             return None
         for node in ast.walk(self.tree):  # no setup(...) call: any dict naming console_scripts
             if isinstance(node, ast.Dict) and any(
@@ -170,7 +180,31 @@ class _Reader:
             return self._binop(node)
         if isinstance(node, ast.Call):
             return self._call(node)
+        if isinstance(node, ast.ListComp):
+            return self._list_comprehension(node)
         raise _UnreadableError(node, f"a {type(node).__name__.lower()} expression")
+
+    def _list_comprehension(self, node: ast.ListComp) -> list[Any]:
+        """``[f'{n} = pkg.{n}:main' for n in nodes]``: one loop over a known list, no ``if``."""
+        loop = node.generators[0]
+        if len(node.generators) != 1 or loop.ifs or not isinstance(loop.target, ast.Name):
+            raise _UnreadableError(node, "a comprehension other than [... for name in list]")
+        name = loop.target.id
+        items = self.eval(loop.iter)
+        if not isinstance(items, (list, tuple)):
+            raise _UnreadableError(loop.iter, "a loop over something not a list")
+        saved = self.names.get(name)
+        result = []
+        try:
+            for item in items:
+                self.names[name] = ast.Constant(item)
+                result.append(self.eval(node.elt))
+        finally:
+            if saved is None:
+                self.names.pop(name, None)
+            else:
+                self.names[name] = saved
+        return result
 
     def _name(self, node: ast.Name) -> Any:
         bound = self.names.get(node.id)

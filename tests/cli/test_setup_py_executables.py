@@ -125,3 +125,44 @@ def test_pkg_executables_of_a_package_whose_setup_py_cannot_be_read_is_one_line(
 ) -> None:
     folder = _package(make_package, SETUP_PY.replace("suffix: str = '_node'", "suffix = x()"))
     assert_user_error(rosl("pkg", "executables", "calc_py"), f"{folder / 'setup.py'}:7:", "x()")
+
+
+def test_entries_from_a_comprehension_and_setup_options_in_a_dict_are_found(
+    make_package: Callable[..., Path], rosl: Callable[..., Result]
+) -> None:
+    setup_py = (
+        "from setuptools import setup\n"
+        "package_name = 'multi_py'\n"
+        "nodes = ['talker', 'listener']\n"
+        "options = dict(\n"
+        "    name=package_name,\n"
+        "    entry_points={'console_scripts': [\n"
+        "        f'{node} = {package_name}.{node}:main' for node in nodes\n"
+        "    ] + ['relay = multi_py.relay:main']},\n"
+        ")\n"
+        "setup(**options)\n"
+    )
+    make_package("multi_py", {"setup.py": setup_py}, manifest=MANIFEST.format(name="multi_py"))
+    result = rosl("pkg", "executables", "multi_py")
+    assert sorted(result.out.splitlines()) == [
+        "multi_py listener",
+        "multi_py relay",
+        "multi_py talker",
+    ], result
+
+
+def test_a_filtered_comprehension_is_one_line_naming_its_line(
+    make_package: Callable[..., Path], rosl: Callable[..., Result]
+) -> None:
+    setup_py = (
+        "from setuptools import setup\n"
+        "nodes = ['a', 'b']\n"
+        "setup(name='filt_py', entry_points={'console_scripts': [\n"
+        "    f'{n} = filt_py.{n}:main' for n in nodes if n != 'b']})\n"
+    )
+    folder = make_package(
+        "filt_py", {"setup.py": setup_py}, manifest=MANIFEST.format(name="filt_py")
+    )
+    assert_user_error(
+        rosl("run", "filt_py", "a"), f"{folder / 'setup.py'}:3:", "a comprehension other than"
+    )
