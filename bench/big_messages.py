@@ -17,7 +17,7 @@ deserialize and the round trip (median of --runs, each --repeat messages), and t
 rosl / rosbags of the round trip (above 1: rosl is faster). Also the time to set ``data``
 from bytes, numpy and array.array, and to read a cloud back with ``read_points``.
 
-    python bench/big_messages.py [--runs 5] [--repeat 20]
+    python bench/big_messages.py [--runs 7] [--repeat 20]
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def setters(repeat: int) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--runs", type=int, default=7)
     parser.add_argument("--repeat", type=int, default=20)
     args = parser.parse_args()
     print(f"serialize + deserialize, rosl message classes vs rosbags; median of {args.runs} runs")

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DATATYPES",
+    "DUMMY_FIELD_PREFIX",
     "create_cloud",
     "create_cloud_xyz32",
     "dtype_from_fields",
@@ -44,6 +45,7 @@ DATATYPES: dict[int, type[np.generic]] = {
     8: np.float64,
 }
 _CLOUD = "sensor_msgs/msg/PointCloud2"
+DUMMY_FIELD_PREFIX = "unnamed_field"  # the name of a field that has none: unnamed_field_<index>
 
 
 def dtype_from_fields(fields: Iterable[Any], point_step: int | None = None) -> np.dtype[Any]:
@@ -60,7 +62,7 @@ def dtype_from_fields(fields: Iterable[Any], point_step: int | None = None) -> n
     formats: list[Any] = []
     offsets: list[int] = []
     for index, field in enumerate(fields):
-        name = field.name or f"unnamed_field_{index}"
+        name = field.name or f"{DUMMY_FIELD_PREFIX}_{index}"
         if field.datatype not in DATATYPES:
             raise PointCloudError(
                 f"PointCloud2 field '{name}': datatype {field.datatype} is not one of "

@@ -2,6 +2,7 @@
 
 from rosl.idl.point_cloud import (
     DATATYPES,
+    DUMMY_FIELD_PREFIX,
     create_cloud,
     create_cloud_xyz32,
     dtype_from_fields,
@@ -13,6 +14,7 @@ from rosl.idl.point_cloud import (
 _DATATYPES = DATATYPES  # the name sensor_msgs_py's own code uses
 
 __all__ = [
+    "DUMMY_FIELD_PREFIX",
     "create_cloud",
     "create_cloud_xyz32",
     "dtype_from_fields",
