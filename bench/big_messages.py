@@ -12,10 +12,14 @@ rosl    the publisher's path, ``Store.serialize_view`` (CDR into one buffer, wha
 rosbags ``Typestore.serialize_cdr`` and ``deserialize_cdr`` on rosbags' own dataclasses
         (ROS 2 Humble store), the deserializer given the same received ``bytes``.
 
-Both encode the same message to the same bytes (checked). Prints MB/s of serialize,
-deserialize and the round trip (median of --runs, each --repeat messages), and the ratio
-rosl / rosbags of the round trip (above 1: rosl is faster). Also the time to set ``data``
-from bytes, numpy and array.array, and to read a cloud back with ``read_points``.
+Both encode the same message to the same bytes (checked). Each call runs --repeat times in
+a row (as a publisher or a subscription runs them), the four blocks alternate --runs times;
+prints MB/s of serialize, deserialize and the round trip (medians), and the ratio rosl /
+rosbags of the round trip (above 1: rosl is faster). Both make the same copies (serialize:
+a zeroed buffer and the data into it; deserialize: the bytes once), so expect about 1x; rosl's
+received arrays are writable and its own, rosbags' are read-only views of its copy. Also the
+time to set ``data`` from bytes, numpy and array.array, and to read a cloud back with
+``read_points_numpy``.
 
     python bench/big_messages.py [--runs 7] [--repeat 20]
 """
