@@ -197,10 +197,19 @@ def message_to_ordereddict(
     no_arr: bool = False,
     no_str: bool = False,
 ) -> OrderedDict[str, Any]:
-    """:func:`message_to_ordered` as the ``OrderedDict`` rosidl_runtime_py returns."""
-    return OrderedDict(
-        message_to_ordered(message, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str)
+    """:func:`message_to_ordered` as rosidl_runtime_py returns it: nested ``OrderedDict``s."""
+    data = message_to_ordered(
+        message, truncate_length=truncate_length, no_arr=no_arr, no_str=no_str
     )
+    return _ordered(data)  # type: ignore[no-any-return]
+
+
+def _ordered(value: Any) -> Any:
+    if isinstance(value, dict):
+        return OrderedDict((key, _ordered(item)) for key, item in value.items())
+    if isinstance(value, list) and value and isinstance(value[0], dict):  # messages, not numbers
+        return [_ordered(item) for item in value]
+    return value
 
 
 def message_slot_types(message: Message) -> OrderedDict[str, str]:

@@ -243,3 +243,14 @@ def test_float32_values_come_back_rounded_to_float32() -> None:
     assert exact.x == 1.125
     rounded = deserialize_message(serialize_message(Point32(x=3.14)), Point32)
     assert round(rounded.x, 2) == 3.14
+
+
+def test_message_to_ordereddict_nests_ordered_dicts_for_nested_messages() -> None:
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+    from rosidl_runtime_py import message_to_ordereddict
+
+    data = message_to_ordereddict(DiagnosticArray(status=[DiagnosticStatus(name="motor")]))
+    assert isinstance(data["header"], OrderedDict)
+    assert isinstance(data["status"][0], OrderedDict)
+    assert list(data["status"][0])[:2] == ["level", "name"]
+    assert data["status"][0]["name"] == "motor"
