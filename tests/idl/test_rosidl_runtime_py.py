@@ -186,21 +186,6 @@ def test_large_arrays_are_set_from_bytes_numpy_and_array_array_alike() -> None:
         assert image.data.tobytes() == raw, type(source)
 
 
-def test_parameter_separator_and_value_helpers_match_rclpy() -> None:
-    from rclpy.parameter import (
-        PARAMETER_SEPARATOR_STRING,
-        Parameter,
-        get_parameter_value,
-        parameter_value_to_python,
-    )
-
-    assert PARAMETER_SEPARATOR_STRING == "."
-    assert parameter_value_to_python(get_parameter_value("1.5")) == 1.5
-    assert parameter_value_to_python(get_parameter_value("[1, 2]")) == [1, 2]
-    assert parameter_value_to_python(get_parameter_value("[1, 'a']")) == "[1, 'a']"
-    assert get_parameter_value("true").type == Parameter.Type.BOOL
-
-
 def _filled() -> list[object]:
     from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
     from nav_msgs.msg import Odometry
