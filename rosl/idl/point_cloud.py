@@ -186,9 +186,10 @@ def create_cloud(
     Args:
         header: the cloud's std_msgs/msg/Header.
         fields: its sensor_msgs/msg/PointField list.
-        points: a structured array whose dtype matches ``fields``; a plain array of shape
-            (N, fields) or (rows, cols, fields) when all fields share one datatype; or an
-            iterable of per-point tuples. A 2-D structured array is an organized cloud.
+        points: a structured array whose dtype is ``dtype_from_fields(fields, point_step)``;
+            a plain array of shape (N, values) or (width, height, values) when all fields
+            share one datatype; or an iterable of per-point tuples. A 2-D structured array
+            (width, height) is an organized cloud, as sensor_msgs_py lays it out.
         point_step: bytes per point (default: the end of the last field).
 
     Raises:
