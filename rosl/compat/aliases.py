@@ -26,6 +26,9 @@ ALIASES: dict[str, str] = {
     "launch_xml": "rosl.compat.launch_xml",
     "launch_yaml": "rosl.compat.launch_yaml",
     "ament_index_python": "rosl.compat.ament_index_python",
+    "tf2_ros": "rosl.compat.tf2_ros",
+    "tf2_py": "rosl.compat.tf2_py",
+    "tf2_geometry_msgs": "rosl.compat.tf2_geometry_msgs",
 }
 
 
