@@ -24,6 +24,9 @@ if TYPE_CHECKING:
     from rosl.node.participant import Participant
 
 
+JUMP_BACK_NS = 1_000_000_000
+
+
 class Feed(Protocol):
     """What feeds a buffer (a TransformListener): its queued data on demand, and its bus."""
 
@@ -53,6 +56,7 @@ class Buffer(BufferCore, BufferInterface):
         self._feeds: list[Feed] = []
         self._changed = threading.Condition()
         self._waiters = 0
+        self._last_now_ns = 0
         from rosl.node.clock import Clock
 
         self.clock = Clock() if node is None else node.get_clock()
@@ -80,8 +84,20 @@ class Buffer(BufferCore, BufferInterface):
 
     def set_transform(self, transform: Any, authority: str) -> None:
         """Store a dynamic transform; waiters and async waits look again."""
+        self._check_time_jump()
         super().set_transform(transform, authority)
         self._new_data()
+
+    def _check_time_jump(self) -> None:
+        """Clear the buffer when the clock went back by more than 1 s (a bag looping).
+
+        tf2_ros does this from a clock jump callback; here it is looked at as data comes.
+        """
+        now = self.clock.now_ns()
+        if now + JUMP_BACK_NS < self._last_now_ns:
+            self._log.warning("Detected jump back in time. Clearing tf buffer.")
+            self.clear()
+        self._last_now_ns = now
 
     def set_transform_static(self, transform: Any, authority: str) -> None:
         """Store a static transform; waiters and async waits look again."""

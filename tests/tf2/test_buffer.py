@@ -157,3 +157,19 @@ def test_buffer_transform_needs_no_import_of_tf2_geometry_msgs() -> None:
 def test_an_unregistered_type_is_a_type_exception() -> None:
     with pytest.raises(tf2_ros.TypeException, match="is not loaded or supported"):
         flipped_buffer().transform(Pose(), "b")
+
+
+def test_a_clock_jumping_back_clears_the_buffer_as_a_looping_bag_needs() -> None:
+    from rosl.node.clock import Clock, ClockType
+
+    buffer = tf2_ros.Buffer()
+    buffer.clock = Clock(clock_type=ClockType.ROS_TIME)
+    buffer.clock.set_sim_time(True)
+    buffer.clock.set_sim_now(30_000_000_000)
+    for seconds in (29.0, 30.0):
+        buffer.set_transform(transform("odom", "base", (seconds, 0.0, 0.0), seconds=seconds), "t")
+    buffer.clock.set_sim_now(2_000_000_000)  # the bag starts over
+    buffer.set_transform(transform("odom", "base", (2.0, 0.0, 0.0), seconds=2.0), "t")
+    found = buffer.lookup_transform("odom", "base", Time())
+    assert xyz(found) == (2.0, 0.0, 0.0)  # not refused as data from the past
+    assert (found.header.stamp.sec, found.header.stamp.nanosec) == (2, 0)

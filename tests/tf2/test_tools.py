@@ -161,3 +161,13 @@ def test_help_is_the_usage_and_exit_0(processes: Processes) -> None:
         out, _ = child.communicate(timeout=60)
         assert child.returncode == 0
         assert out.startswith(f"usage: {program} ")
+
+
+def test_tf2_echos_buffer_answers_the_tf2_frames_service(processes: Processes) -> None:
+    tf2_ros(processes, "static_transform_publisher", "--frame-id", "a", "--child-frame-id", "b")
+    echo = tf2_ros(processes, "tf2_echo", "a", "b")
+    assert echo.wait_for("^At time ", timeout=60), echo.text("err")
+    call = processes.rosl("service", "call", "/tf2_frames", "tf2_msgs/srv/FrameGraph")
+    out, err = call.communicate(timeout=60)
+    assert call.returncode == 0, err
+    assert "frame_yaml=\"b: \\n  parent: 'a'\\n  broadcaster: 'default_authority'\\n" in out
