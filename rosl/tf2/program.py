@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from typing import TYPE_CHECKING, Any
@@ -18,13 +19,18 @@ def user_args(args: list[str] | None) -> list[str]:
 
 
 def run(args: list[str] | None, node_name: str, body: Callable[[Any], None]) -> int:
-    """Init rosl, run ``body(node)`` with a node named ``node_name``, then clean up."""
+    """Init rosl, run ``body(node)`` with a node named ``node_name``, then clean up.
+
+    A closed stdout (the program piped into ``head``) ends the program quietly.
+    """
     import rosl
 
     rosl.init(sys.argv if args is None else args)
     node = rosl.Node(node_name)
     try:
         body(node)
+    except BrokenPipeError:  # `tf2_echo a b | head`: the reader is gone, so are we
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     finally:
         node.destroy_node()
         rosl.try_shutdown()

@@ -11,6 +11,8 @@ import pytest
 from tests.graph.support import Watched
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from tests.conftest import Processes
 
 TURTLE = """
@@ -171,3 +173,31 @@ def test_tf2_echos_buffer_answers_the_tf2_frames_service(processes: Processes) -
     out, err = call.communicate(timeout=60)
     assert call.returncode == 0, err
     assert "frame_yaml=\"b: \\n  parent: 'a'\\n  broadcaster: 'default_authority'\\n" in out
+
+
+LAUNCH = """
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        Node(package='tf2_ros', executable='static_transform_publisher', name='base_to_laser',
+             arguments=['--x', '0.1', '--z', '0.2', '--frame-id', 'base_link',
+                        '--child-frame-id', 'laser']),
+        Node(package='tf2_ros', executable='static_transform_publisher',
+             arguments=['0', '0', '1', '0', '0', '0', 'laser', 'lens']),
+    ])
+"""
+
+
+def test_a_launch_file_starts_static_transform_publishers_as_ros2_launch_would(
+    processes: Processes, tmp_path: Path
+) -> None:
+    path = tmp_path / "tf.launch.py"
+    path.write_text(LAUNCH)
+    launch = Watched(processes.rosl("launch", str(path)))
+    block = echo_block(processes, "base_link", "lens")
+    assert block[1] == "- Translation: [0.100, 0.000, 1.200]"
+    assert launch.wait_for(r"\[base_to_laser\]: Spinning until stopped", timeout=30)
+    assert launch.interrupt() == 0
