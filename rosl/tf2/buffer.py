@@ -35,6 +35,9 @@ class Feed(Protocol):
     def drain(self) -> None:
         """Store every transform received but not yet handed to the buffer."""
 
+    def stopped(self) -> bool:
+        """Whether its node's context was shut down (a wait then ends at once)."""
+
 
 def timeout_ns(timeout: Any) -> int:
     """A Duration (rclpy or message), a number of seconds, or None (no wait), in ns."""
@@ -126,16 +129,19 @@ class Buffer(BufferCore, BufferInterface):
         def fed() -> bool:
             for feed in feeds:
                 feed.drain()
-            return ready()
+            return ready() or any(feed.stopped() for feed in feeds)
 
-        self._waiters += 1
+        with self._changed:
+            self._waiters += 1
         try:
             if participant is not None:
-                return participant.wait(fed, seconds)
+                participant.wait(fed, seconds)
+                return ready()
             with self._changed:
                 return self._changed.wait_for(ready, seconds)
         finally:
-            self._waiters -= 1
+            with self._changed:
+                self._waiters -= 1
 
     # --- blocking ----------------------------------------------------------------------------
 

@@ -104,6 +104,10 @@ class TransformListener:
                 if call is not None:
                     call()
 
+    def stopped(self) -> bool:
+        """Whether the node's context was shut down (Ctrl-C): blocking waits end then."""
+        return not self.node.context.ok()
+
     def unregister(self) -> None:
         """Stop listening (and feeding the buffer)."""
         self.buffer.detach(self)

@@ -109,7 +109,7 @@ def test_tf2_monitor_reports_frames_and_broadcasters(processes: Processes) -> No
     assert everything.matching(r"^Frame: camera, published by /static_transform_publisher_\w+")
     rate = everything.matching(r"^Node: /turtle_broadcaster ([0-9.e+]+) Hz, Average Delay: ")
     assert 1.0 < float(rate[0][1]) < 1000.0  # 20 Hz, over the time the monitor watched
-    assert "All Broadcasters:" in everything.text("err")  # tf2_monitor writes it to stderr
+    assert everything.wait_for("^All Broadcasters:$", "err")  # tf2_monitor writes it to stderr
     assert chain.wait_for(r"^Chain is: ", timeout=90), chain.text("err")
     assert chain.lines()[0].startswith(
         "Waiting for transform chain to become available between world and camera "
