@@ -41,7 +41,7 @@ class TransformListener:
         tf_static_topic: str = DEFAULT_STATIC_TF_TOPIC,
         static_only: bool = False,
     ) -> None:
-        self.buffer = buffer
+        self._buffer = buffer
         if node is None:
             node = _own_node(self)
         self.node = node
@@ -69,6 +69,17 @@ class TransformListener:
         buffer.attach(self)
         if spin_thread:
             self._start_thread()
+
+    @property
+    def buffer(self) -> Buffer:
+        """The buffer fed (may be replaced: the new one is fed, and drained while it waits)."""
+        return self._buffer
+
+    @buffer.setter
+    def buffer(self, buffer: Buffer) -> None:
+        self._buffer.detach(self)
+        self._buffer = buffer
+        buffer.attach(self)
 
     def _start_thread(self) -> None:
         from rosl.executor import SingleThreadedExecutor

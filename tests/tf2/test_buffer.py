@@ -173,3 +173,47 @@ def test_a_clock_jumping_back_clears_the_buffer_as_a_looping_bag_needs() -> None
     found = buffer.lookup_transform("odom", "base", Time())
     assert xyz(found) == (2.0, 0.0, 0.0)  # not refused as data from the past
     assert (found.header.stamp.sec, found.header.stamp.nanosec) == (2, 0)
+
+
+def test_lookup_coroutines_finish_at_once_or_after_the_data_comes() -> None:
+    now = Time(seconds=1234.5)
+    sent = transform("foo", "bar", (42.0, -3.14, 0.0), seconds=1234.5)
+    buffer = tf2_ros.Buffer()
+    waiting = buffer.lookup_transform_async("foo", "bar", now)
+    waiting_full = buffer.lookup_transform_full_async("foo", now, "bar", now, "foo")
+    for coroutine in (waiting, waiting_full):
+        coroutine.send(None)  # suspended: nothing to look up yet
+    assert buffer.set_transform(sent, "unittest") is None
+    for coroutine in (waiting, waiting_full, buffer.lookup_transform_async("foo", "bar", now)):
+        with pytest.raises(StopIteration) as finished:
+            coroutine.send(None)
+        assert finished.value.value == sent
+    assert buffer.lookup_transform("foo", "bar", now) == sent
+
+
+def test_one_node_broadcasts_and_listens_and_static_frames_accumulate(ros) -> None:
+    from rosl.executor import SingleThreadedExecutor
+
+    node = ros.Node("test_broadcaster_listener")
+    broadcaster = tf2_ros.TransformBroadcaster(node)
+    static_broadcaster = tf2_ros.StaticTransformBroadcaster(node)
+    listener = tf2_ros.TransformListener(buffer=tf2_ros.Buffer(), node=node)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    sent = transform("foo", "bar", (42.0, -3.14, 0.0), seconds=1.0)
+    broadcaster.sendTransform(sent)
+    found = listener.buffer.lookup_transform("foo", "bar", Time(seconds=1.0), Duration(seconds=30))
+    assert found == sent
+    listener.buffer = tf2_ros.Buffer()  # as tf2_ros's own test swaps it: the new one is fed
+    static_broadcaster.sendTransform(transform("foo", "bar", (24.0, 0.0, 0.0), seconds=2.1))
+    static_broadcaster.sendTransform(transform("foo", "qux", (10.0, 0.0, 0.0), seconds=3.1))
+    qux = listener.buffer.lookup_transform("foo", "qux", Time(seconds=3.5), Duration(seconds=30))
+    assert (xyz(qux), qux.header.stamp.sec, qux.header.stamp.nanosec) == ((10.0, 0.0, 0.0), 3,
+                                                                           500_000_000)  # fmt: skip
+    # the second message repeated the first static frame: a listener joining now gets both
+    late = tf2_ros.Buffer()
+    tf2_ros.TransformListener(late, ros.Node("late_listener"))
+    bar = late.lookup_transform("foo", "bar", Time(), Duration(seconds=30))
+    assert xyz(bar) == (24.0, 0.0, 0.0)
+    assert late.can_transform("foo", "qux", Time(), Duration(seconds=30))
+    node.destroy_node()
