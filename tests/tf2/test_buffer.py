@@ -217,3 +217,18 @@ def test_one_node_broadcasts_and_listens_and_static_frames_accumulate(ros) -> No
     assert xyz(bar) == (24.0, 0.0, 0.0)
     assert late.can_transform("foo", "qux", Time(), Duration(seconds=30))
     node.destroy_node()
+
+
+def test_a_listener_without_a_node_makes_its_own_and_unregister_stops_it(ros) -> None:
+    talker = ros.Node("talker")
+    static_broadcaster = tf2_ros.StaticTransformBroadcaster(talker)
+    buffer = tf2_ros.Buffer()
+    listener = tf2_ros.TransformListener(buffer)
+    assert listener.node.get_name().startswith("transform_listener_impl_")
+    assert listener.node.get_parameter("use_sim_time").value is False
+    static_broadcaster.sendTransform(transform("map", "odom", (1.0, 0.0, 0.0)))
+    assert xyz(buffer.lookup_transform("map", "odom", Time(), Duration(seconds=30))) == (
+        1.0, 0.0, 0.0)  # fmt: skip
+    listener.unregister()
+    static_broadcaster.sendTransform(transform("map", "elsewhere"))
+    assert not buffer.can_transform("map", "elsewhere", Time(), Duration(seconds=0.5))
