@@ -4,12 +4,14 @@
 (look up at that fixed time, in seconds) and ``-p PRECISION``. Each block gives the pose of
 TARGET in SOURCE: the time, translation, quaternion, roll/pitch/yaw in radians and degrees
 and the 4x4 matrix, with tf2_echo's digits (its unpadded nanoseconds and signed zeros too).
-While the transform is not there yet it says why, at most once a second.
+While the transform is not there yet it says why, at most once a second. The quaternion line
+reads as Humble's unless ``ROS_DISTRO`` names Jazzy or later, which add ``(xyzw)``.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -98,6 +100,18 @@ def _is_number(text: str) -> bool:
     return True
 
 
+HUMBLE_AND_OLDER = ("", "humble", "galactic", "foxy", "eloquent", "dashing")
+
+
+def quaternion_label() -> str:
+    """How tf2_echo names the quaternion line: Jazzy and later add ``(xyzw)``.
+
+    ``ROS_DISTRO`` chooses, as for bags; unset, rosl prints what Humble prints.
+    """
+    newer = os.environ.get("ROS_DISTRO", "").strip().lower() not in HUMBLE_AND_OLDER
+    return "in Quaternion (xyzw)" if newer else "in Quaternion"
+
+
 def echo_text(transform: Transform, stamp_ns: int, precision: int = 3) -> str:
     """tf2_echo's block for a transform at ``stamp_ns``."""
     p = precision
@@ -113,7 +127,7 @@ def echo_text(transform: Transform, stamp_ns: int, precision: int = 3) -> str:
         [
             f"At time {sec}.{nanosec}",
             f"- Translation: {listed(transform.translation)}",
-            f"- Rotation: in Quaternion {listed(transform.rotation)}",
+            f"- Rotation: {quaternion_label()} {listed(transform.rotation)}",
             f"- Rotation: in RPY (radian) {listed((roll, pitch, yaw))}",
             f"- Rotation: in RPY (degree) "
             f"{listed(tuple(math.degrees(a) for a in (roll, pitch, yaw)))}",

@@ -108,3 +108,13 @@ def test_tf2_monitor_report_text() -> None:
         "Net delay     avg = 0.02: max = 2\n\nFrames:\nFrame: turtle1, "
     )
     assert "camera" not in out  # only the chain's frames
+
+
+def test_the_quaternion_line_follows_ros_distro(monkeypatch: pytest.MonkeyPatch) -> None:
+    quaternion_line = 2
+    monkeypatch.delenv("ROS_DISTRO", raising=False)
+    humble = echo.echo_text(Transform(), 0).splitlines()[quaternion_line]
+    assert humble == "- Rotation: in Quaternion [0.000, 0.000, 0.000, 1.000]"
+    monkeypatch.setenv("ROS_DISTRO", "jazzy")
+    jazzy = echo.echo_text(Transform(), 0).splitlines()[quaternion_line]
+    assert jazzy == "- Rotation: in Quaternion (xyzw) [0.000, 0.000, 0.000, 1.000]"
