@@ -28,6 +28,9 @@ ALIASES: dict[str, str] = {
     "ament_index_python": "rosl.compat.ament_index_python",
     "rosidl_runtime_py": "rosl.compat.rosidl_runtime_py",
     "sensor_msgs_py": "rosl.compat.sensor_msgs_py",
+    "tf2_ros": "rosl.compat.tf2_ros",
+    "tf2_py": "rosl.compat.tf2_py",
+    "tf2_geometry_msgs": "rosl.compat.tf2_geometry_msgs",
 }
 
 

@@ -1,16 +1,16 @@
 """``rosl tf``: the TF frame tree (view_frames, without Graphviz) and transforms (tf2_echo).
 
 Listens to ``/tf`` and ``/tf_static`` (the latter transient-local, so a late listener still gets
-the static transforms), keeps the latest transform per edge plus a short history of receive
-times for the rate, and composes transforms through the tree with a few lines of quaternion
-math (no numpy). Each edge remembers which publisher sent it, so the broadcaster shown is the
-node that really broadcast that edge.
+the static transforms). The transforms go into :mod:`rosl.tf2`'s frame tree, the same one
+``tf2_ros.Buffer`` is, so ``rosl tf echo`` and ``tf2_echo`` compute alike (time 0 is the latest
+common time, edges are interpolated). Beside it each edge keeps what the tree does not: which
+publisher sent it (so the broadcaster shown is the node that really broadcast that edge) and a
+short history of receive times, for the rate.
 """
 
 from __future__ import annotations
 
 import difflib
-import math
 import time
 from collections import deque
 from dataclasses import dataclass, field
@@ -18,68 +18,21 @@ from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import PUBLISHER
 from rosl.introspection.errors import IntrospectionError
+from rosl.tf2.echo import echo_text as _tf2_echo_text
+from rosl.tf2.errors import TransformException
+from rosl.tf2.messages import transform_of
+from rosl.tf2.tree import FrameTree
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
     from pathlib import Path
 
     from rosl.introspection.session import Session
+    from rosl.tf2.transform import Transform
 
 TOPICS = ("/tf", "/tf_static")
 HISTORY = 100  # receive times kept per edge, for the rate
 DRAWN = ("svg", "png", "pdf")  # pictures rosl can draw itself
-Vector = tuple[float, float, float]
-Quaternion = tuple[float, float, float, float]  # x, y, z, w
-
-
-# --- transforms ------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class Transform:
-    """A rigid transform: rotate by ``rotation``, then move by ``translation``."""
-
-    translation: Vector = (0.0, 0.0, 0.0)
-    rotation: Quaternion = (0.0, 0.0, 0.0, 1.0)
-
-    def __mul__(self, other: Transform) -> Transform:
-        """``self`` then ``other`` (parent←a times a←b gives parent←b)."""
-        (x, y, z), (dx, dy, dz) = self.translation, _rotate(self.rotation, other.translation)
-        return Transform((x + dx, y + dy, z + dz), _qmul(self.rotation, other.rotation))
-
-    def inverse(self) -> Transform:
-        """The transform going the other way."""
-        x, y, z, w = self.rotation
-        norm = x * x + y * y + z * z + w * w or 1.0
-        inverse: Quaternion = (-x / norm, -y / norm, -z / norm, w / norm)
-        back = _rotate(inverse, self.translation)
-        return Transform((-back[0], -back[1], -back[2]), inverse)
-
-    def rpy(self) -> Vector:
-        """Roll, pitch, yaw in radians (tf2's Matrix3x3::getRPY)."""
-        x, y, z, w = self.rotation
-        roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
-        pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
-        yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-        return (roll, pitch, yaw)
-
-
-def _qmul(a: Quaternion, b: Quaternion) -> Quaternion:
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    )
-
-
-def _rotate(q: Quaternion, v: Vector) -> Vector:
-    x, y, z, w = q
-    norm = x * x + y * y + z * z + w * w or 1.0
-    rx, ry, rz, _ = _qmul(_qmul(q, (v[0], v[1], v[2], 0.0)), (-x, -y, -z, w))
-    return (rx / norm, ry / norm, rz / norm)
 
 
 # --- the buffer -------------------------------------------------------------------------------
@@ -87,12 +40,11 @@ def _rotate(q: Quaternion, v: Vector) -> Vector:
 
 @dataclass(slots=True)
 class Edge:
-    """The latest transform parent→child, who sent it, and recent receive times (ns)."""
+    """An edge parent→child as heard: its latest stamp, who sent it, recent receive times (ns)."""
 
     parent: str
     child: str
     static: bool
-    transform: Transform
     stamp_ns: int
     senders: set[tuple[int, int]] = field(default_factory=set)
     received: deque[int] = field(default_factory=lambda: deque(maxlen=HISTORY))
@@ -108,23 +60,26 @@ class Edge:
 
 
 class TfBuffer:
-    """Edges by child frame (a frame has one parent; the latest message wins)."""
+    """The frame tree (lookups) and, by child frame, what was heard of each edge."""
 
     def __init__(self) -> None:
         self.edges: dict[str, Edge] = {}
+        self.tree = FrameTree()
 
     def add(self, message: Any, static: bool, sender: tuple[int, int], received_ns: int) -> None:
         """Store every transform of a ``tf2_msgs/msg/TFMessage``."""
         for ts in message.transforms:
             parent, child = ts.header.frame_id.lstrip("/"), ts.child_frame_id.lstrip("/")
-            t, r = ts.transform.translation, ts.transform.rotation
             stamp = ts.header.stamp.sec * 1_000_000_000 + ts.header.stamp.nanosec
-            transform = Transform((t.x, t.y, t.z), (r.x, r.y, r.z, r.w))
+            transform = transform_of(ts)
+            if not self.tree.insert(parent, child, stamp, transform, "", static):
+                self.tree.clear()  # time went back past the cache (a bag looping): start over
+                self.tree.insert(parent, child, stamp, transform, "", static)
             edge = self.edges.get(child)
             if edge is None or edge.parent != parent or edge.static != static:
-                edge = self.edges[child] = Edge(parent, child, static, transform, stamp)
+                edge = self.edges[child] = Edge(parent, child, static, stamp)
                 edge.oldest_stamp_ns = stamp
-            edge.transform, edge.stamp_ns = transform, stamp
+            edge.stamp_ns = stamp
             edge.senders.add(sender)
             edge.received.append(received_ns)
 
@@ -150,30 +105,25 @@ class TfBuffer:
     def lookup(self, source: str, target: str) -> tuple[Transform, int]:
         """The pose of ``target`` in ``source`` (tf2_echo SOURCE TARGET) and its stamp (ns).
 
+        Looked up at the latest common time of the edges between them, as tf2_echo does.
+
         Raises:
-            IntrospectionError: a frame is unknown, or the two are not connected.
+            IntrospectionError: a frame is unknown, the two are not connected, or tf2 cannot
+                compute it (an extrapolation, in tf2's words).
         """
         for frame in (source, target):
             if frame not in self.frames():
                 raise IntrospectionError(_unknown_frame(frame, self.frames()))
         up_source, up_target = self.path_to_root(source), self.path_to_root(target)
-        common = next((f for f in up_source if f in up_target), None)
-        if common is None:
+        if not set(up_source) & set(up_target):
             raise IntrospectionError(
                 f"frames '{source}' and '{target}' are not connected: '{source}' is in the tree "
                 f"of '{up_source[-1]}', '{target}' in the tree of '{up_target[-1]}'"
             )
-        chain = [*up_source[: up_source.index(common)], *up_target[: up_target.index(common)]]
-        stamps = [self.edges[f].stamp_ns for f in chain if not self.edges[f].static]
-        pose = self._down(up_source, common).inverse() * self._down(up_target, common)
-        return pose, min(stamps, default=0)
-
-    def _down(self, path: list[str], ancestor: str) -> Transform:
-        """ancestor←frame, for ``path`` = frame ... ancestor ... (from :meth:`path_to_root`)."""
-        result = Transform()
-        for child in reversed(path[: path.index(ancestor)]):
-            result = result * self.edges[child].transform
-        return result
+        try:
+            return self.tree.lookup(source, target, 0)
+        except TransformException as err:
+            raise IntrospectionError(str(err).splitlines()[0]) from None
 
 
 def _unknown_frame(frame: str, known: set[str]) -> str:
@@ -280,42 +230,23 @@ def echo(
             raise
     else:
         return
+    block = echo_text(transform, stamp)
     while True:
-        yield echo_text(transform, stamp)
+        yield block
         if once or not listener.spin_for(1.0 / rate if rate > 0 else 1.0):
             return
-        transform, stamp = listener.buffer.lookup(source, target)
+        try:
+            block = echo_text(*listener.buffer.lookup(source, target))
+        except IntrospectionError as err:  # tf2_echo reports a failure and goes on
+            block = f"Failure at {time.time():f}\nException thrown:{err}"
 
 
 # --- rendering --------------------------------------------------------------------------------
 
 
-def _fmt(values: tuple[float, ...]) -> str:
-    return "[" + ", ".join(f"{round(v, 3) + 0.0:.3f}" for v in values) + "]"
-
-
 def echo_text(transform: Transform, stamp_ns: int) -> str:
     """tf2_echo's block: time, translation, quaternion, RPY in radians and degrees, matrix."""
-    rpy = transform.rpy()
-    x, y, z, w = transform.rotation
-    rows = [
-        (1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)),
-        (2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)),
-        (2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)),
-    ]
-    matrix = [(*row, transform.translation[i]) for i, row in enumerate(rows)] + [(0, 0, 0, 1)]
-    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
-    return "\n".join(
-        [
-            f"At time {sec}.{nanosec:09d}",
-            f"- Translation: {_fmt(transform.translation)}",
-            f"- Rotation: in Quaternion {_fmt(transform.rotation)}",
-            f"- Rotation: in RPY (radian) {_fmt(rpy)}",
-            f"- Rotation: in RPY (degree) {_fmt(tuple(math.degrees(a) for a in rpy))}",
-            "- Matrix:",
-            *("  " + " ".join(f"{round(v, 3) + 0.0:6.3f}" for v in row) for row in matrix),
-        ]
-    )
+    return _tf2_echo_text(transform, stamp_ns)
 
 
 def _about(edge: Edge) -> str:

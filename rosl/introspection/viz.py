@@ -16,8 +16,9 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from rosl.introspection.errors import IntrospectionError
-from rosl.introspection.tf import TfBuffer, Transform
+from rosl.introspection.tf import TfBuffer
 from rosl.sim.render import Scene, footprint_points, write
+from rosl.tf2.transform import Transform
 
 if TYPE_CHECKING:
     from collections.abc import Callable

@@ -8,7 +8,8 @@ from types import SimpleNamespace
 import pytest
 
 from rosl.introspection.errors import IntrospectionError
-from rosl.introspection.tf import TfBuffer, Transform, echo_text, frames_dot, frames_text
+from rosl.introspection.tf import TfBuffer, echo_text, frames_dot, frames_text
+from rosl.tf2.transform import Transform
 
 
 def yaw(angle: float) -> tuple[float, float, float, float]:
@@ -94,15 +95,17 @@ def test_frames_in_separate_trees_are_not_connected() -> None:
     assert frames_text(buffer).splitlines()[-1] == "note: 2 separate trees (roots: map, odom)"
 
 
-def test_echo_text_has_tf2_echo_lines_with_three_decimals() -> None:
+def test_echo_text_has_tf2_echo_lines_with_three_decimals(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("ROS_DISTRO", raising=False)  # Humble's quaternion line
     pose, stamp = turtlebot().lookup("odom", "base_scan")
     lines = echo_text(pose, stamp).splitlines()
+    # as tf2_echo prints them: nanoseconds unpadded, tf2's getEulerYPR pitch of -0.0
     assert lines[:5] == [
-        "At time 6.000000000",
+        "At time 6.0",
         "- Translation: [1.000, 1.968, 0.182]",
         "- Rotation: in Quaternion [0.000, 0.000, 0.707, 0.707]",
-        "- Rotation: in RPY (radian) [0.000, 0.000, 1.571]",
-        "- Rotation: in RPY (degree) [0.000, 0.000, 90.000]",
+        "- Rotation: in RPY (radian) [0.000, -0.000, 1.571]",
+        "- Rotation: in RPY (degree) [0.000, -0.000, 90.000]",
     ]
     assert lines[5] == "- Matrix:"
     assert lines[6].split() == ["0.000", "-1.000", "0.000", "1.000"]

@@ -1,5 +1,5 @@
 """rclpy.time."""
 
-from rosl.node.clock import Time
+from rosl.node.clock import Duration, Time
 
-__all__ = ["Time"]
+__all__ = ["Duration", "Time"]
