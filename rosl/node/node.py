@@ -170,16 +170,18 @@ class Node:
         callback_group: Any = None,
         event_callbacks: Any = None,
         coalesce: bool | None = None,
+        publisher_class: type[Publisher] | None = None,
     ) -> Publisher:
         """Create a publisher of ``msg_type`` on ``topic`` (relative names use the namespace).
 
         ``coalesce=True`` batches small messages into shared datagrams, each at most 1 ms late
-        (default: the ``ROSL_COALESCE`` environment variable, else off).
+        (default: the ``ROSL_COALESCE`` environment variable, else off). ``publisher_class``
+        (a subclass of Publisher, as rclpy.lifecycle's LifecyclePublisher) builds the publisher.
         """
         from rosl.node.publisher import Publisher
 
         del callback_group, event_callbacks
-        publisher = Publisher(
+        publisher = (publisher_class or Publisher)(
             self,
             _message_class(msg_type),
             self.resolve_topic_name(topic),

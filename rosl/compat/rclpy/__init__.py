@@ -36,8 +36,8 @@ __all__ = [
 
 _SUBMODULES = frozenset(
     ("callback_groups", "client", "clock", "context", "duration", "exceptions", "executors",
-     "guard_condition", "logging", "node", "parameter", "publisher", "qos", "service", "signals",
-     "subscription", "task", "time", "timer", "utilities", "waitable")
+     "guard_condition", "lifecycle", "logging", "node", "parameter", "publisher", "qos",
+     "service", "signals", "subscription", "task", "time", "timer", "utilities", "waitable")
 )  # fmt: skip
 
 
