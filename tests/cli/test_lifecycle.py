@@ -51,8 +51,10 @@ def managed(processes: Processes) -> None:
     """Three lifecycle nodes (one refuses to configure) and a plain one, in another process."""
     processes.python(NODES)
     wait_graph(
-        lambda g: g.count(SERVER, "/refuser/get_transition_graph") == 1
-        and g.count(SERVER, "/plain/set_parameters") == 1
+        lambda g: (
+            g.count(SERVER, "/refuser/get_transition_graph") == 1
+            and g.count(SERVER, "/plain/set_parameters") == 1
+        )
     )
 
 
@@ -91,11 +93,16 @@ def test_list_all_shows_the_whole_transition_graph(managed, processes) -> None:
     assert result.code == 0, result
     lines = result.out.splitlines()
     assert len(lines) == 25 * 3
-    assert lines[:6] == UNCONFIGURED.splitlines()[:3] + [
-        "- transition_success [10]", "\tStart: configuring", "\tGoal: inactive",
-    ]  # fmt: skip
+    assert lines[:6] == [
+        *UNCONFIGURED.splitlines()[:3],
+        *["- transition_success [10]", "\tStart: configuring", "\tGoal: inactive"],
+    ]
     assert "- transition_failure [61]" in lines
-    assert lines[-3:] == ["- transition_error [62]", "\tStart: errorprocessing", "\tGoal: finalized"]
+    assert lines[-3:] == [
+        "- transition_error [62]",
+        "\tStart: errorprocessing",
+        "\tGoal: finalized",
+    ]
 
 
 @pytest.mark.parametrize(
@@ -103,16 +110,20 @@ def test_list_all_shows_the_whole_transition_graph(managed, processes) -> None:
     [
         (["get", "/nobody"], ["Node not found: /nobody"]),
         (["get", "/lc_talke"], ["Node not found: /lc_talke", "did you mean '/lc_talker'"]),
-        (["list", "/plain"], ["Node not found: /plain is not a lifecycle node",
-                              "serves no /plain/get_state"]),  # fmt: skip
+        (
+            ["list", "/plain"],
+            ["Node not found: /plain is not a lifecycle node", "serves no /plain/get_state"],
+        ),
         (["set", "/plain", "configure"], ["Node not found: /plain is not a lifecycle node"]),
-        (["set", "/lc_talker", "activate"],
-         ["Unknown transition requested, available ones are: configure [1], shutdown [5]"]),
+        (
+            ["set", "/lc_talker", "activate"],
+            ["Unknown transition requested, available ones are: configure [1], shutdown [5]"],
+        ),
         (["set", "/lc_talker", "7"], ["Unknown transition requested"]),
         (["set", "/refuser", "configure"], ["Transitioning failed"]),
     ],
     ids=["unknown", "typo", "plain-list", "plain-set", "not-offered", "not-offered-id", "refused"],
-)  # fmt: skip
+)
 def test_bad_requests_are_one_line_and_exit_1(managed, processes, args, fragments) -> None:
     assert_user_error(run(processes, "lifecycle", *args), *fragments)
 

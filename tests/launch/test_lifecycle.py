@@ -200,8 +200,7 @@ def test_xml_lifecycle_node_with_autostart_is_configured_and_activated(
     ("source", "message"),
     [
         (
-            "launch_ros.actions.LifecycleNode(package='lifecycle', "
-            "executable='lifecycle_talker')",
+            "launch_ros.actions.LifecycleNode(package='lifecycle', executable='lifecycle_talker')",
             "LifecycleNode(executable='lifecycle_talker') needs name=",
         ),
         (

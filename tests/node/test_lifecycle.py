@@ -167,8 +167,12 @@ def test_a_lifecycle_publisher_sends_only_while_its_node_is_active(lifecycle, ro
 
 def test_the_lifecycle_services_of_a_node_in_another_process(ros, spawn):
     from lifecycle_msgs.msg import State, TransitionEvent
-    from lifecycle_msgs.srv import ChangeState, GetAvailableStates, GetAvailableTransitions
-    from lifecycle_msgs.srv import GetState
+    from lifecycle_msgs.srv import (
+        ChangeState,
+        GetAvailableStates,
+        GetAvailableTransitions,
+        GetState,
+    )
 
     child = spawn(MANAGED_TALKER)
     child.expect("^ready$")
