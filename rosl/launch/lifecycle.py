@@ -5,7 +5,8 @@ of its own) as soon as a LifecycleNode runs: it listens to each lifecycle node's
 ``<node>/transition_event`` (each message becomes a StateTransition event on the supervising
 loop) and calls its ``<node>/change_state`` when a ChangeState event asks (one request at a time
 per node, sent once the service is there; a refused transition is logged as launch_ros does).
-``autostart=True`` (launch_ros' later distros) asks for configure, then activate.
+``autostart=True`` (launch_ros' later distros) asks for configure, then activate;
+LifecycleTransition asks named nodes for a list of transitions.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import os
 import threading
 from typing import TYPE_CHECKING, Any
 
+from rosl.launch.description import Action
 from rosl.launch.errors import LaunchError
 from rosl.launch.lifecycle_events import ChangeState, StateTransition
 from rosl.launch.ros_actions import Node, _shown, _user_site
@@ -63,8 +65,9 @@ class LifecycleNode(Node):
             manager = LifecycleManager.of(supervisor, context)
             manager.watch(self)
             if _truthy(context, self.autostart):
-                manager.change_state(self, 1)
-                manager.change_state(self, 3)
+                batch = object()
+                manager.change_state(self, 1, batch)
+                manager.change_state(self, 3, batch)
         super().execute(context)
 
 
@@ -75,11 +78,12 @@ def _truthy(context: LaunchContext, value: Any) -> bool:
 
 
 class _Request:
-    """One ChangeState request waiting to be sent or answered."""
+    """One ChangeState request waiting to be sent or answered (``batch``: dropped if one fails)."""
 
-    def __init__(self, action: LifecycleNode, transition_id: int) -> None:
+    def __init__(self, action: LifecycleNode, transition_id: int, batch: object = None) -> None:
         self.action = action
         self.transition_id = transition_id
+        self.batch = batch
         self.future: Any = None
 
 
@@ -127,9 +131,13 @@ class LifecycleManager:
         self._actions.append(action)
         self._jobs.append(lambda node: self._setup(node, action))
 
-    def change_state(self, action: LifecycleNode, transition_id: int) -> None:
-        """Ask the node for a transition (after the requests already asked of it)."""
-        self._jobs.append(lambda node: self._requests.append(_Request(action, transition_id)))
+    def change_state(self, action: LifecycleNode, transition_id: int, batch: object = None) -> None:
+        """Ask the node for a transition (after the requests already asked of it).
+
+        Requests of one ``batch`` that follow a refused one are dropped.
+        """
+        request = _Request(action, transition_id, batch)
+        self._jobs.append(lambda node: self._requests.append(request))
 
     def stop(self) -> None:
         """Leave the bus (the thread ends within 0.1 s)."""
@@ -190,7 +198,7 @@ class LifecycleManager:
         busy: set[int] = set()
         for request in list(self._requests):
             key = id(request.action)
-            if key in busy:
+            if key in busy or request not in self._requests:  # (dropped by a refusal meanwhile)
                 continue
             busy.add(key)
             client = self._clients[key]
@@ -211,6 +219,8 @@ class LifecycleManager:
         else:
             why = ""
         if not success:
+            if request.batch is not None:
+                self._requests = [r for r in self._requests if r.batch is not request.batch]
             label = ChangeState.valid_transitions.get(request.transition_id, request.transition_id)
             text = (
                 f"Failed to make transition '{label}' for LifecycleNode "
@@ -219,6 +229,45 @@ class LifecycleManager:
             self.supervisor.call_soon_threadsafe(
                 lambda: self.supervisor.log("ERROR", _LOGGER, text)
             )
+
+
+class LifecycleTransition(Action):
+    """Take transitions of lifecycle nodes by name, one after the other (launch_ros, Jazzy).
+
+    Each node takes ``transition_ids`` in order, the next once the previous one is done; a
+    refused transition drops the rest for that node (and is logged).
+    """
+
+    def __init__(
+        self, *, lifecycle_node_names: list[Any], transition_ids: list[Any], **kwargs: Any
+    ) -> None:
+        super().__init__(**kwargs)
+        if not transition_ids:
+            raise LaunchError(f"{_user_site()}LifecycleTransition: no transition_ids provided")
+        if not lifecycle_node_names:
+            raise LaunchError(
+                f"{_user_site()}LifecycleTransition: no lifecycle_node_names provided"
+            )
+        self.lifecycle_node_names = list(lifecycle_node_names)
+        self.transition_ids = list(transition_ids)
+
+    def execute(self, context: LaunchContext) -> None:
+        """Queue the transitions of each named lifecycle node the launch started."""
+        names = {"/" + perform(context, n).lstrip("/") for n in self.lifecycle_node_names}
+        ids = []
+        for value in self.transition_ids:
+            text = str(value) if isinstance(value, int) else perform(context, value)
+            if not text.strip().isdigit() or int(text) not in ChangeState.valid_transitions:
+                raise LaunchError(f"LifecycleTransition: '{text}' is not a lifecycle transition id")
+            ids.append(int(text))
+        manager = LifecycleManager.find(context)
+        if manager is None:
+            return
+        for action in manager.actions():
+            if action.lifecycle_node_name in names:
+                batch = object()
+                for transition_id in ids:
+                    manager.change_state(action, transition_id, batch)
 
 
 class _StopAtShutdown:

@@ -8,6 +8,7 @@ autostart>``, and the one-line errors of bad lifecycle actions.
 
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import pytest
@@ -264,3 +265,62 @@ def test_print_shows_a_lifecycle_node_as_the_node_it_starts(rosl: Rosl) -> None:
     assert lines[0].startswith("[lifecycle_talker-1] "), out
     assert lines[0].endswith(" lifecycle_talker --ros-args -r __node:=lc_talker"), out
     assert lines[1] == "    node: lc_talker (package lifecycle, namespace /)", out
+
+
+def test_lifecycle_transition_takes_each_nodes_list_and_stops_at_a_refusal(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    path = write_launch(
+        launch_dir,
+        "transitions.launch.py",
+        """
+        import launch
+        from launch_ros.actions import LifecycleNode, LifecycleTransition
+        from lifecycle_msgs.msg import Transition
+        def talker(name):
+            return LifecycleNode(package="lifecycle", executable="lifecycle_talker", name=name,
+                                 namespace="", output="screen")
+        def generate_launch_description():
+            return launch.LaunchDescription([
+                talker("lc_talker"),
+                talker("lc_second"),
+                LifecycleTransition(lifecycle_node_names=["lc_talker"], transition_ids=[
+                    Transition.TRANSITION_CONFIGURE, Transition.TRANSITION_ACTIVATE]),
+                LifecycleTransition(lifecycle_node_names=["/lc_second"], transition_ids=[
+                    Transition.TRANSITION_ACTIVATE, Transition.TRANSITION_CONFIGURE]),
+            ])
+        """,
+    )
+    launch = rosl.start("launch", str(path))
+
+    assert launch.wait_for(r"^\[lifecycle_talker-1\] .*on_activate\(\) is called", timeout=60.0)
+    assert launch.wait_for(
+        r"^\[ERROR\] \[launch_ros.actions.lifecycle_node\]: Failed to make transition "
+        r"'TRANSITION_ACTIVATE' for LifecycleNode '/lc_second'$",
+        timeout=60.0,
+    ), launch.both()
+    pids = launch.pids()
+    assert launch.interrupt() == 0, launch.both()
+    assert talker_said(launch) == [
+        "on_configure() is called (from unconfigured).", "on_activate() is called.",
+    ], launch.both()  # fmt: skip
+    # lc_second refused activate: its configure, queued after it, was dropped
+    assert not [line for line in launch.lines() if line.startswith("[lifecycle_talker-2] ")
+                and "() is called" in line], launch.both()  # fmt: skip
+    assert_all_gone(pids)
+
+
+def test_a_launch_test_of_the_managed_talker_passes_under_rosl_launch_test(rosl: Rosl) -> None:
+    test = PACKAGES / "lifecycle" / "test" / "test_lifecycle.launch.py"
+    output = rosl.start("launch_test", str(test))
+
+    code = output.finish(120)
+    text = output.both()
+    assert code == 0, text
+    for name in (
+        "TestManagedTalker.test_talker_goes_through_its_states",
+        "TestManagedTalkerAfterShutdown.test_talker_exits_cleanly",
+    ):
+        assert re.search(rf"^{name.split('.')[1]} \(.*{name}\) \.\.\. ok$", text, re.M), text
+    assert text.count("\nOK") == 2, text
+    assert_all_gone(output.pids())

@@ -1,7 +1,7 @@
 """launch_ros.actions (components are refused in one line)."""
 
 from rosl.compat.unsupported import unsupported_names
-from rosl.launch.lifecycle import LifecycleNode
+from rosl.launch.lifecycle import LifecycleNode, LifecycleTransition
 from rosl.launch.ros_actions import (
     ComposableNodeContainer,
     LoadComposableNodes,
@@ -16,6 +16,7 @@ PushROSNamespace = PushRosNamespace  # the later distros' spelling
 __all__ = [
     "ComposableNodeContainer",
     "LifecycleNode",
+    "LifecycleTransition",
     "LoadComposableNodes",
     "Node",
     "PushROSNamespace",
