@@ -95,6 +95,18 @@ def talker_said(launch: Output) -> list[str]:
     ]
 
 
+def refused_then_interrupted(launch: Output, transition: str, node: str) -> list[int]:
+    """Wait for launch_ros' line about a refused transition, then Ctrl-C; the launched pids."""
+    assert launch.wait_for(
+        r"^\[ERROR\] \[launch_ros.actions.lifecycle_node\]: Failed to make transition "
+        rf"'{transition}' for LifecycleNode '{node}'$",
+        timeout=60.0,
+    ), launch.both()
+    pids = launch.pids()
+    assert launch.interrupt() == 0, launch.both()
+    return pids
+
+
 def test_the_real_lifecycle_demo_launch_file_runs_to_its_end(rosl: Rosl) -> None:
     launch = rosl.start("launch", "lifecycle", "lifecycle_demo.launch.py")
 
@@ -160,13 +172,7 @@ def test_a_transition_the_node_refuses_is_logged_as_launch_ros_does(
     )
     launch = rosl.start("launch", str(path))
 
-    assert launch.wait_for(
-        r"^\[ERROR\] \[launch_ros.actions.lifecycle_node\]: Failed to make transition "
-        r"'TRANSITION_ACTIVATE' for LifecycleNode '/lc_talker'$",
-        timeout=60.0,
-    ), launch.both()
-    pids = launch.pids()
-    assert launch.interrupt() == 0, launch.both()
+    pids = refused_then_interrupted(launch, "TRANSITION_ACTIVATE", "/lc_talker")
     assert talker_said(launch) == []  # activate is not a transition from unconfigured
     assert_all_gone(pids)
 
@@ -294,13 +300,7 @@ def test_lifecycle_transition_takes_each_nodes_list_and_stops_at_a_refusal(
     launch = rosl.start("launch", str(path))
 
     assert launch.wait_for(r"^\[lifecycle_talker-1\] .*on_activate\(\) is called", timeout=60.0)
-    assert launch.wait_for(
-        r"^\[ERROR\] \[launch_ros.actions.lifecycle_node\]: Failed to make transition "
-        r"'TRANSITION_ACTIVATE' for LifecycleNode '/lc_second'$",
-        timeout=60.0,
-    ), launch.both()
-    pids = launch.pids()
-    assert launch.interrupt() == 0, launch.both()
+    pids = refused_then_interrupted(launch, "TRANSITION_ACTIVATE", "/lc_second")
     assert talker_said(launch) == [
         "on_configure() is called (from unconfigured).", "on_activate() is called.",
     ], launch.both()  # fmt: skip
