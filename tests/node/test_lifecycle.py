@@ -227,3 +227,38 @@ def test_the_lifecycle_services_of_a_node_in_another_process(ros, spawn):
         ("inactive", "activating"), ("activating", "active"),
     ]  # fmt: skip
     assert (events[0].timestamp, events[0].transition.id, events[0].transition.label) == (0, 0, "")
+
+
+def test_destroying_twice_or_nothing_is_false_as_in_rclpy(lifecycle):
+    from std_msgs.msg import String
+
+    # ros2/demos' lifecycle talker destroys its timer and publisher in on_cleanup, and again
+    # in on_shutdown (None if it was never configured): rclpy answers False, nothing raises
+    class Talker(lifecycle.Node):
+        timer = publisher = None
+
+        def on_configure(self, state):
+            self.publisher = self.create_lifecycle_publisher(String, "chatter", 10)
+            self.timer = self.create_timer(1.0, lambda: None)
+            return lifecycle.TransitionCallbackReturn.SUCCESS
+
+        def on_cleanup(self, state):
+            assert self.destroy_timer(self.timer)
+            assert self.destroy_publisher(self.publisher)
+            return lifecycle.TransitionCallbackReturn.SUCCESS
+
+        def on_shutdown(self, state):
+            assert not self.destroy_timer(self.timer)
+            assert not self.destroy_publisher(self.publisher)
+            return lifecycle.TransitionCallbackReturn.SUCCESS
+
+    never = Talker("never", enable_communication_interface=False)
+    assert never.trigger_shutdown() == lifecycle.TransitionCallbackReturn.SUCCESS
+    talker = Talker("talker", enable_communication_interface=False)
+    talker.trigger_configure()
+    assert talker.trigger_cleanup() == lifecycle.TransitionCallbackReturn.SUCCESS
+    assert talker.trigger_shutdown() == lifecycle.TransitionCallbackReturn.SUCCESS
+    assert state(talker) == (4, "finalized")
+    assert not talker.destroy_subscription(None)
+    assert not talker.destroy_client(None)
+    assert not talker.destroy_service(None)
