@@ -311,7 +311,7 @@ def test_lifecycle_transition_takes_each_nodes_list_and_stops_at_a_refusal(
 
 
 def test_a_launch_test_of_the_managed_talker_passes_under_rosl_launch_test(rosl: Rosl) -> None:
-    test = PACKAGES / "lifecycle" / "test" / "test_lifecycle.launch.py"
+    test = PACKAGES / "lifecycle" / "test" / "managed_talker.launch.py"
     output = rosl.start("launch_test", str(test))
 
     code = output.finish(120)
