@@ -180,10 +180,9 @@ class LifecycleNodeMixin(ManagedEntity):
         """Have ``entity``'s transition callbacks called by the default ones."""
         self._managed_entities[entity] = None
 
-    def _entities_answer(
-        self, name: str, state: LifecycleState, entities: Iterable[ManagedEntity] | None = None
-    ) -> TransitionCallbackReturn:
-        for entity in list(entities if entities is not None else self._managed_entities):
+    def _entities_answer(self, name: str, state: LifecycleState) -> TransitionCallbackReturn:
+        """Call each managed entity's ``name`` callback; the first answer not SUCCESS wins."""
+        for entity in list(self._managed_entities):
             answer: TransitionCallbackReturn = getattr(entity, name)(state)
             if answer != TransitionCallbackReturn.SUCCESS:
                 return answer
@@ -222,9 +221,7 @@ class LifecycleNodeMixin(ManagedEntity):
         assert isinstance(self, Node)
         publisher = Node.create_publisher(self, *args, **kwargs, publisher_class=LifecyclePublisher)
         assert isinstance(publisher, LifecyclePublisher)
-        if self._state_machine.current.label == "active":
-            publisher._enabled = True  # created while active: it sends at once, as in rclcpp
-        self._managed_entities[publisher] = None
+        self._managed_entities[publisher] = None  # enabled by the next activate, as in rclpy
         return publisher
 
     def destroy_lifecycle_publisher(self, publisher: LifecyclePublisher) -> bool:

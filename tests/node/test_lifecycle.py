@@ -262,3 +262,20 @@ def test_destroying_twice_or_nothing_is_false_as_in_rclpy(lifecycle):
     assert not talker.destroy_subscription(None)
     assert not talker.destroy_client(None)
     assert not talker.destroy_service(None)
+
+
+def test_a_lifecycle_publisher_made_while_active_waits_for_the_next_activate(lifecycle):
+    from std_msgs.msg import String
+
+    node = lifecycle.LifecycleNode("late", enable_communication_interface=False)
+    node.trigger_configure()
+    node.trigger_activate()
+    late = node.create_lifecycle_publisher(String, "late", 10)
+
+    assert not late.is_activated  # rclpy enables managed entities in on_activate only
+    node.trigger_deactivate()
+    node.trigger_activate()
+    assert late.is_activated
+    assert node.destroy_lifecycle_publisher(late)
+    node.trigger_deactivate()
+    assert late.is_activated  # no longer managed: the node leaves it alone
