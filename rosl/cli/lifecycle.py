@@ -65,10 +65,12 @@ def list_(
 def get(node_name: str | None, include_hidden: bool, timeout: float, domain_id: int | None) -> None:
     """Get lifecycle state for one or more nodes."""
     with Session(domain_id) as session:
-        lines = lifecycle.get_states(
+        lines, problems = lifecycle.get_states(
             session, node_name, include_hidden=include_hidden, timeout=timeout
         )
     render.lines(lines)
+    for problem in problems:
+        render.warn(problem)
 
 
 @command.command("set")

@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, Any
 
+from rosl.errors import RoslError
 from rosl.graph.records import SERVER
 from rosl.idl.names import did_you_mean
 from rosl.introspection.errors import IntrospectionError
@@ -99,18 +100,25 @@ def get_states(
     *,
     include_hidden: bool = False,
     timeout: float = DEFAULT_TIMEOUT,
-) -> list[str]:
-    """``ros2 lifecycle get [NODE]``: ``label [id]``, or ``/node: label [id]`` for every node."""
+) -> tuple[list[str], list[str]]:
+    """``ros2 lifecycle get [NODE]``: (stdout lines, stderr lines).
+
+    One node: ``label [id]`` (a node that does not answer is an error). Every node: ``/node:
+    label [id]`` each, and a node that does not answer is a line on stderr, as ros2 has it.
+    """
     if name:
-        nodes = [lifecycle_node(session, name, include_hidden=include_hidden)]
-    else:
-        nodes = node_names(session, include_hidden=include_hidden)
-    lines = []
-    for fqn in nodes:
+        fqn = lifecycle_node(session, name, include_hidden=include_hidden)
         state = _call(session, f"{fqn}/get_state", GET_STATE_TYPE, None, timeout).current_state
-        prefix = "" if name else f"{fqn}: "
-        lines.append(f"{prefix}{state.label} [{state.id}]")
-    return lines
+        return [f"{state.label} [{state.id}]"], []
+    lines, problems = [], []
+    for fqn in node_names(session, include_hidden=include_hidden):
+        try:
+            response = _call(session, f"{fqn}/get_state", GET_STATE_TYPE, None, timeout)
+        except RoslError as err:
+            problems.append(f"Exception while calling service of node '{fqn}': {err}")
+            continue
+        lines.append(f"{fqn}: {response.current_state.label} [{response.current_state.id}]")
+    return lines, problems
 
 
 def transitions(

@@ -143,3 +143,40 @@ def test_node_info_lists_the_lifecycle_services_and_event_topic(managed, process
         ("get_transition_graph", "GetAvailableTransitions"),
     ]:  # fmt: skip
         assert f"    /lc_talker/{name}: lifecycle_msgs/srv/{kind}" in out, out
+
+
+STUCK = """
+import time
+import rosl.compat; rosl.compat.install(force=True)
+import rclpy
+from rclpy.lifecycle import Node
+
+class Stuck(Node):
+    def _on_get_state(self, request, response):  # a node too busy to answer
+        time.sleep(60)
+        return response
+
+rclpy.init()
+rclpy.spin(Stuck("stuck"))
+"""
+
+
+def test_get_of_every_node_reports_one_that_does_not_answer_and_goes_on(managed, processes) -> None:
+    processes.python(STUCK)
+    wait_graph(lambda g: g.count(SERVER, "/stuck/get_transition_graph") == 1)
+
+    result = run(processes, "lifecycle", "get", "--timeout", "1")
+
+    assert result.code == 0, result
+    assert result.out == (
+        "/lc_talker: unconfigured [1]\n/refuser: unconfigured [1]\n"
+        "/robot/lc_other: unconfigured [1]\n"
+    )
+    assert result.err == (
+        "Exception while calling service of node '/stuck': service /stuck/get_state did not "
+        "answer within 1 s\n"
+    )
+    assert_user_error(
+        run(processes, "lifecycle", "get", "/stuck", "--timeout", "1"),
+        "service /stuck/get_state did not answer within 1 s",
+    )
