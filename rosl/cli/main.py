@@ -32,7 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "interface": ("rosl.cli.interface", "Show information about ROS interfaces"),
     "launch": ("rosl.cli.launch", "Run a launch file"),
     "launch_test": ("rosl.cli.launch_test", "Run a launch test (ROS 2's launch_test)"),
-    "lifecycle": ("rosl.cli.planned:lifecycle", "Lifecycle nodes: not in rosl yet"),
+    "lifecycle": ("rosl.cli.lifecycle", "Various lifecycle related sub-commands"),
     "multicast": ("rosl.cli.multicast", "Various multicast related sub-commands"),
     "node": ("rosl.cli.node", "Various node related sub-commands"),
     "param": ("rosl.cli.param", "Various param related sub-commands"),

@@ -469,14 +469,17 @@ class Shutdown(Action):
 
 
 class EmitEvent(Action):
-    """Emit an event; rosl understands ``Shutdown``."""
+    """Emit an event; rosl understands ``Shutdown`` and launch_ros' lifecycle ``ChangeState``."""
 
     def __init__(self, *, event: Any, **kwargs: Any) -> None:
+        from rosl.launch.lifecycle_events import ChangeState
+
         super().__init__(**kwargs)
-        if not isinstance(event, Shutdown):
+        if not isinstance(event, (Shutdown, ChangeState)):
             raise LaunchError(
                 f"EmitEvent(event={type(event).__name__}(...)) is not supported by rosl: "
-                "the only event it emits is launch.events.Shutdown"
+                "the events it emits are launch.events.Shutdown and "
+                "launch_ros.events.lifecycle.ChangeState"
             )
         self.event = event
 

@@ -236,6 +236,9 @@ TAGS: dict[str, Tag] = {
     "timer": _tag("period", children=True),
     "executable": _tag(f"cmd {_PROCESS}", "env"),
     "node": _tag(f"pkg exec namespace exec_name args ros_args {_PROCESS}", "param remap env"),
+    "lifecycle_node": _tag(
+        f"pkg exec namespace exec_name args ros_args autostart {_PROCESS}", "param remap env"
+    ),
     "set_parameter": _tag("name value"),
     "set_remap": _tag("from to"),
 }
@@ -338,8 +341,21 @@ def build_executable(entity: Entity) -> Any:
 
 def build_node(entity: Entity) -> Any:
     """``<node pkg exec name namespace args ros_args ...>`` with param, remap, env children."""
+    return _node(entity, ros_actions.Node)
+
+
+def build_lifecycle_node(entity: Entity) -> Any:
+    """``<lifecycle_node name namespace autostart ...>``: a ``<node>`` with a lifecycle."""
+    from rosl.launch.lifecycle import LifecycleNode
+
+    if entity.value("name") is None:
+        raise entity.fail(f"{entity.label} needs the attribute 'name'")
+    return _node(entity, LifecycleNode, autostart=_flag(entity, "autostart", substitutions=True))
+
+
+def _node(entity: Entity, kind: Any, **extra: Any) -> Any:
     options = _process(entity)
-    return ros_actions.Node(
+    return kind(
         package=_text(entity, "pkg", required=True),
         executable=_text(entity, "exec", required=True),
         namespace=_text(entity, "namespace"),
@@ -351,6 +367,7 @@ def build_node(entity: Entity) -> Any:
         ],
         arguments=command_words(entity, "args"),
         ros_arguments=command_words(entity, "ros_args"),
+        **extra,
         **options,
     )
 
@@ -469,6 +486,7 @@ BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "timer": build_timer,
     "executable": build_executable,
     "node": build_node,
+    "lifecycle_node": build_lifecycle_node,
     "set_parameter": _set_parameter,
     "set_remap": lambda e: ros_actions.SetRemap(
         _text(e, "from", required=True), _text(e, "to", required=True), **_condition(e)
@@ -480,7 +498,6 @@ _COMPONENTS = "it runs C++ components, which rosl cannot (start each as a <node>
 _REFUSED = {
     "node_container": _COMPONENTS,
     "load_composable_node": _COMPONENTS,
-    "lifecycle_node": "rosl has no managed (lifecycle) nodes yet",
 }
 _LOCATED = re.compile(r"^\S+:\d+: ")
 

@@ -1,8 +1,7 @@
 """launch_ros's actions: Node, PushRosNamespace, SetParameter, SetRemap (and ParameterValue).
 
-Components (ComposableNodeContainer, LoadComposableNodes) and LifecycleNode are refused with
-one line naming the launch file's line: components are C++ plugins, and rosl has no managed
-nodes yet.
+Components (ComposableNodeContainer, LoadComposableNodes) are refused with one line naming
+the launch file's line: components are C++ plugins. LifecycleNode lives in launch/lifecycle.py.
 
 A Node becomes ``<executable> [arguments] --ros-args -r __node:=NAME -r __ns:=NS
 --params-file FILE -r from:=to ...`` — the same ``--ros-args`` a user could type. Parameter
@@ -373,26 +372,6 @@ class LoadComposableNodes(Action):
 
     def __init__(self, *, composable_node_descriptions: Any = None, **kwargs: Any) -> None:
         raise _refuse_components("LoadComposableNodes", composable_node_descriptions)
-
-
-NO_LIFECYCLE = "rosl has no managed (lifecycle) nodes yet"
-
-
-def refuse_lifecycle(module: str, name: str) -> LaunchError:
-    """The one line for a lifecycle name of launch_ros (LifecycleNode, ChangeState, ...)."""
-    return LaunchError(f"{_user_site()}'{module}.{name}' is not supported: {NO_LIFECYCLE}")
-
-
-class LifecycleNode(Action):
-    """Refused when created: rosl has no managed (lifecycle) nodes yet."""
-
-    def __init__(self, *, name: SomeSubstitutions = None, **kwargs: Any) -> None:
-        node = f" '{_shown(name)}'" if name is not None else ""
-        error = refuse_lifecycle("launch_ros.actions", "LifecycleNode")
-        raise LaunchError(
-            f"{error}; start the node{node} with launch_ros.actions.Node if it needs no "
-            "lifecycle transitions"
-        )
 
 
 def _yaml_value(value: Any) -> str:

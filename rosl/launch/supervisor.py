@@ -15,6 +15,7 @@ print a line (stdout or stderr, whatever ``output`` says) and exit, on the super
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import ctypes
 import datetime
@@ -149,6 +150,7 @@ class Supervisor:
         self._started: list[tuple[ProcessEvent, LaunchContext]] = []  # for the handlers, next
         self.keep_alive = False  # run() goes on after the last process, until a shutdown
         self._requests: list[str] = []  # shutdowns asked for by other threads
+        self._soon: collections.deque[Callable[[], None]] = collections.deque()  # other threads'
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -266,6 +268,14 @@ class Supervisor:
     def add_handler(self, handler: Any, context: LaunchContext) -> None:
         """Register an OnProcessStart/OnProcessExit handler."""
         self._handlers.append((handler, context))
+
+    def call_soon_threadsafe(self, function: Callable[[], None]) -> None:
+        """Run ``function`` on the supervising loop (from any thread; within 0.1 s)."""
+        self._soon.append(function)
+
+    def emit(self, event: Any) -> None:
+        """Give ``event`` (with ``kind`` and ``action``) to the handlers that match it."""
+        self._emit(event, None)
 
     def _notify(self, running: Running, event: ProcessEvent) -> None:
         if running.action is not None:  # not the launcher's own helpers (the recorder)
@@ -409,6 +419,8 @@ class Supervisor:
 
     def _step(self) -> None:
         self._handle_signals()
+        while self._soon:
+            self._soon.popleft()()
         while self._started:  # start events, once what started them has been processed
             event, where = self._started.pop(0)
             self._emit(event, where)

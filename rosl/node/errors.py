@@ -50,3 +50,7 @@ class ThreadCountError(NodeError, ValueError):
 
 class NotInitializedError(NodeError):
     """rosl.init() was not called (or the context is shut down)."""
+
+
+class LifecycleTransitionError(NodeError, RuntimeError):
+    """A lifecycle transition that does not start in the node's current state."""

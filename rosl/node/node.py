@@ -170,16 +170,18 @@ class Node:
         callback_group: Any = None,
         event_callbacks: Any = None,
         coalesce: bool | None = None,
+        publisher_class: type[Publisher] | None = None,
     ) -> Publisher:
         """Create a publisher of ``msg_type`` on ``topic`` (relative names use the namespace).
 
         ``coalesce=True`` batches small messages into shared datagrams, each at most 1 ms late
-        (default: the ``ROSL_COALESCE`` environment variable, else off).
+        (default: the ``ROSL_COALESCE`` environment variable, else off). ``publisher_class``
+        (a subclass of Publisher, as rclpy.lifecycle's LifecyclePublisher) builds the publisher.
         """
         from rosl.node.publisher import Publisher
 
         del callback_group, event_callbacks
-        publisher = Publisher(
+        publisher = (publisher_class or Publisher)(
             self,
             _message_class(msg_type),
             self.resolve_topic_name(topic),
@@ -353,7 +355,9 @@ class Node:
         return self.create_publisher(get_message_class(type_name), topic, qos)
 
     def destroy_publisher(self, publisher: Publisher) -> bool:
-        """Remove a publisher (sending what it still holds)."""
+        """Remove a publisher (sending what it still holds); False if it is not this node's."""
+        if publisher not in self.publishers:
+            return False
         publisher.flush()
         self.participant.remove_replayer(publisher.topic, publisher)
         if publisher._writer in self.participant.writers:
@@ -361,22 +365,30 @@ class Node:
         return self._remove(self.publishers, publisher)
 
     def destroy_subscription(self, subscription: Subscription) -> bool:
-        """Remove a subscription."""
+        """Remove a subscription; False if it is not this node's."""
+        if subscription not in self.subscriptions:
+            return False
         subscription.close()
         return self._remove(self.subscriptions, subscription)
 
     def destroy_timer(self, timer: Timer) -> bool:
-        """Remove a timer."""
+        """Remove a timer; False if it is not this node's (None, or destroyed before)."""
+        if timer not in self.timers:
+            return False
         timer.destroy()
         return self._remove(self.timers, timer)
 
     def destroy_service(self, service: Service) -> bool:
-        """Remove a service server."""
+        """Remove a service server; False if it is not this node's."""
+        if service not in self.services:
+            return False
         service.close()
         return self._remove(self.services, service)
 
     def destroy_client(self, client: Client) -> bool:
-        """Remove a service client."""
+        """Remove a service client; False if it is not this node's."""
+        if client not in self.clients:
+            return False
         client.close()
         return self._remove(self.clients, client)
 

@@ -1,7 +1,7 @@
 """The Python launch API as real launch files use it: ``import launch`` / ``import launch_ros``
 and attribute access, ``ament_index_python``, substitutions, environment actions, event
 handlers, and real launch files of ros2/demos written for Python nodes; what rosl cannot run
-(components, managed nodes, names it lacks) is one line and exit 1.
+(components, names it lacks) is one line and exit 1.
 
 The packages live in tests/launch/python_api (see its README), put on ROSL_PACKAGE_PATH.
 """
@@ -244,16 +244,9 @@ def test_real_depth_demo_starts_the_executable_found_in_its_package(rosl: Rosl) 
             "'launch_ros.actions.ComposableNodeContainer' is not supported: it runs C++ "
             "components, which rosl cannot: composition::Talker, composition::Listener",
         ),
-        (
-            "lifecycle",
-            "lifecycle_demo.launch.py",
-            11,
-            "'launch_ros.actions.LifecycleNode' is not supported: rosl has no managed "
-            "(lifecycle) nodes yet; start the node 'lc_talker' with launch_ros.actions.Node",
-        ),
     ],
 )
-def test_real_component_and_lifecycle_launch_files_are_refused_in_one_line(
+def test_real_component_launch_files_are_refused_in_one_line(
     rosl: Rosl, package: str, file_name: str, line: int, message: str
 ) -> None:
     code, out, err = rosl.run("launch", package, file_name)

@@ -1,9 +1,9 @@
-"""launch_ros.actions (components and lifecycle nodes are refused in one line)."""
+"""launch_ros.actions (components are refused in one line)."""
 
 from rosl.compat.unsupported import unsupported_names
+from rosl.launch.lifecycle import LifecycleNode, LifecycleTransition
 from rosl.launch.ros_actions import (
     ComposableNodeContainer,
-    LifecycleNode,
     LoadComposableNodes,
     Node,
     PushRosNamespace,
@@ -16,6 +16,7 @@ PushROSNamespace = PushRosNamespace  # the later distros' spelling
 __all__ = [
     "ComposableNodeContainer",
     "LifecycleNode",
+    "LifecycleTransition",
     "LoadComposableNodes",
     "Node",
     "PushROSNamespace",

@@ -1,13 +1,7 @@
-"""launch_ros.event_handlers: OnStateTransition needs lifecycle nodes, which rosl has not."""
+"""launch_ros.event_handlers: OnStateTransition."""
 
-from typing import Any
+from rosl.compat.unsupported import unsupported_names
+from rosl.launch.lifecycle_events import OnStateTransition
 
-from rosl.launch.ros_actions import refuse_lifecycle
-
-__all__: list[str] = []
-
-
-def __getattr__(name: str) -> Any:
-    if name.startswith("__"):
-        raise AttributeError(name)
-    raise refuse_lifecycle("launch_ros.event_handlers", name)
+__all__ = ["OnStateTransition"]
+__getattr__ = unsupported_names("launch_ros.event_handlers", __all__)

@@ -35,10 +35,32 @@ __all__ = [
 
 
 _SUBMODULES = frozenset(
-    ("callback_groups", "client", "clock", "context", "duration", "exceptions", "executors",
-     "guard_condition", "logging", "node", "parameter", "publisher", "qos", "serialization",
-     "service", "signals", "subscription", "task", "time", "timer", "utilities", "waitable")
-)  # fmt: skip
+    (
+        "callback_groups",
+        "client",
+        "clock",
+        "context",
+        "duration",
+        "exceptions",
+        "executors",
+        "guard_condition",
+        "lifecycle",
+        "logging",
+        "node",
+        "parameter",
+        "publisher",
+        "qos",
+        "serialization",
+        "service",
+        "signals",
+        "subscription",
+        "task",
+        "time",
+        "timer",
+        "utilities",
+        "waitable",
+    )
+)
 
 
 def __getattr__(name: str) -> Any:

@@ -1,11 +1,12 @@
-"""launch_ros.events: lifecycle events need lifecycle nodes, which rosl has not."""
+"""launch_ros.events: the lifecycle events (``launch_ros.events.lifecycle``)."""
 
 import importlib
 from typing import Any
 
 from rosl.compat.unsupported import unsupported_names
+from rosl.launch.lifecycle_events import matches_node_name
 
-__all__: list[str] = []
+__all__ = ["matches_node_name"]
 _unsupported = unsupported_names("launch_ros.events", __all__)
 
 

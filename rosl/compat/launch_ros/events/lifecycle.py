@@ -1,13 +1,7 @@
-"""launch_ros.events.lifecycle: ChangeState and friends need lifecycle nodes (not in rosl)."""
+"""launch_ros.events.lifecycle: ChangeState, StateTransition, matches_node_name."""
 
-from typing import Any
+from rosl.compat.unsupported import unsupported_names
+from rosl.launch.lifecycle_events import ChangeState, StateTransition, matches_node_name
 
-from rosl.launch.ros_actions import refuse_lifecycle
-
-__all__: list[str] = []
-
-
-def __getattr__(name: str) -> Any:
-    if name.startswith("__"):
-        raise AttributeError(name)
-    raise refuse_lifecycle("launch_ros.events.lifecycle", name)
+__all__ = ["ChangeState", "StateTransition", "matches_node_name"]
+__getattr__ = unsupported_names("launch_ros.events.lifecycle", __all__)
