@@ -270,6 +270,8 @@ XMLLaunchDescriptionSource = PythonLaunchDescriptionSource  # the file's suffix 
 class ExecuteProcess(Action):
     """Start a process (launch.actions.ExecuteProcess)."""
 
+    completes_later = True  # when the process has exited (OnExecutionComplete)
+
     def __init__(
         self,
         *,
@@ -384,7 +386,7 @@ class ExecuteProcess(Action):
 def _flag(context: LaunchContext, value: Any) -> bool:
     if isinstance(value, bool):
         return value
-    return perform(context, value).strip().lower() in ("true", "1")
+    return perform(context, value).strip().lower() in ("true", "1", "yes", "on")
 
 
 def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
@@ -401,6 +403,8 @@ def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
 
 class TimerAction(Action):
     """Run actions after a delay."""
+
+    completes_later = True  # when its actions have run (OnExecutionComplete)
 
     def __init__(
         self, *, period: float | SomeSubstitutions, actions: list[Any], **kwargs: Any
@@ -422,8 +426,14 @@ class TimerAction(Action):
             seconds = -1.0
         if not seconds >= 0:  # (NaN too)
             raise LaunchError(f"a timer's period must be a number of seconds >= 0, not '{text}'")
-        if context.supervisor is not None:
-            context.supervisor.call_later(seconds, lambda: process(self.actions, context))
+        supervisor = context.supervisor
+        if supervisor is not None:
+
+            def fire() -> None:
+                process(self.actions, context)
+                supervisor.completed(self, context)
+
+            supervisor.call_later(seconds, fire)
 
     def children(self) -> list[Any]:
         """The delayed actions."""
@@ -469,19 +479,28 @@ class Shutdown(Action):
 
 
 class EmitEvent(Action):
-    """Emit an event; rosl understands ``Shutdown``."""
+    """Emit an event: ``Shutdown``, or ``ShutdownProcess``/``SignalProcess`` for processes."""
 
     def __init__(self, *, event: Any, **kwargs: Any) -> None:
+        from rosl.launch.events import ProcessTargetedEvent
+
         super().__init__(**kwargs)
-        if not isinstance(event, Shutdown):
+        if not isinstance(event, (Shutdown, ProcessTargetedEvent)):
             raise LaunchError(
                 f"EmitEvent(event={type(event).__name__}(...)) is not supported by rosl: "
-                "the only event it emits is launch.events.Shutdown"
+                "the events it emits are launch.events.Shutdown and "
+                "launch.events.process.ShutdownProcess / SignalProcess"
             )
         self.event = event
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
         """Act on the event."""
+        from rosl.launch.events import ProcessTargetedEvent, emit_to_processes
+
+        if isinstance(self.event, ProcessTargetedEvent):
+            if context.supervisor is not None:
+                emit_to_processes(self.event, context.supervisor)
+            return None
         return [self.event]
 
 

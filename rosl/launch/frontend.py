@@ -129,17 +129,42 @@ def _plain(entity: Entity, name: str, *, required: bool = False) -> str | None:
     return re.sub(r"\\(.)", r"\1", _scalar(entity, name, value))
 
 
+# launch types a boolean attribute by YAML rules: YAML 1.1's words, as PyYAML reads them
+TRUE_WORDS = ("true", "yes", "on")
+FALSE_WORDS = ("false", "no", "off")
+
+
 def _flag(entity: Entity, name: str, *, substitutions: bool = False) -> Any:
-    """A true/false attribute (with ``substitutions``, a ``$(...)`` resolved at run time)."""
+    """A boolean attribute (with ``substitutions``, a ``$(...)`` resolved at run time).
+
+    ``true``/``false`` and YAML's ``yes``/``no``/``on``/``off``, as launch's frontend reads them.
+    """
     value = entity.value(name)
     if value is None or isinstance(value, bool):
         return value
     text = _scalar(entity, name, value)
-    if text.strip().lower() in ("true", "false"):
-        return text.strip().lower() == "true"
+    word = text.strip().lower()
+    if word in TRUE_WORDS or word in FALSE_WORDS:
+        return word in TRUE_WORDS
     if substitutions and "$(" in text:
         return _substituted(entity, text)
-    raise entity.fail(f"attribute '{name}' of {entity.label} must be true or false, not '{text}'")
+    raise entity.fail(
+        f"attribute '{name}' of {entity.label} must be a boolean (true/false, yes/no, on/off), "
+        f"not '{text}'"
+    )
+
+
+def _on_exit(entity: Entity) -> Any:
+    """``on_exit="shutdown"``: the launch ends when the process does (the only word launch has)."""
+    value = entity.value("on_exit")
+    if value is None:
+        return None
+    text = _scalar(entity, "on_exit", value).strip()
+    if text != "shutdown":
+        raise entity.fail(
+            f"attribute 'on_exit' of {entity.label} can only be 'shutdown', not '{text}'"
+        )
+    return [actions.Shutdown(reason=f"{entity.kind} exited (on_exit=shutdown)")]
 
 
 def _number(entity: Entity, name: str) -> float | None:
@@ -219,7 +244,7 @@ _NAME_VALUE = _tag("name value")
 _PARAM = _tag("name value type from allow_substs", "param")
 _PROCESS = (
     "cwd name launch-prefix output respawn respawn_delay shell emulate_tty sigterm_timeout "
-    "sigkill_timeout"
+    "sigkill_timeout on_exit"
 )
 TAGS: dict[str, Tag] = {
     "arg": _tag("name default description", "choice"),
@@ -325,6 +350,7 @@ def _process(entity: Entity) -> dict[str, Any]:
         "sigterm_timeout": _text(entity, "sigterm_timeout"),
         "sigkill_timeout": _text(entity, "sigkill_timeout"),
         "additional_env": dict(_name_values(entity, "env")) or None,
+        "on_exit": _on_exit(entity),
     }
     return {k: v for k, v in options.items() if v is not None} | _condition(entity)
 
@@ -482,7 +508,6 @@ _REFUSED = {
     "load_composable_node": _COMPONENTS,
     "lifecycle_node": "rosl has no managed (lifecycle) nodes yet",
 }
-_LOCATED = re.compile(r"^\S+:\d+: ")
 
 
 def build_action(entity: Entity) -> Any:
@@ -502,20 +527,7 @@ def build_action(entity: Entity) -> Any:
         )
     entity.check(TAGS[entity.kind], guarded=True)
     action = BUILDERS[entity.kind](entity)
-    visit = action.visit
-    where = f"{entity.path}:{entity.line}"
-
-    def located_visit(context: Any) -> Any:
-        try:
-            return visit(context)
-        except LaunchError as err:
-            text = str(err)
-            if _LOCATED.match(text):
-                raise
-            text = text.removeprefix(f"{entity.path}: ")
-            raise LaunchError(f"{where}: {text}") from None
-
-    action.visit = located_visit
+    action.location = f"{entity.path}:{entity.line}"  # errors it raises when it runs name it
     return action
 
 

@@ -196,8 +196,24 @@ class ExecutableInPackage(FindPackage):
         return f"ExecInPkg(pkg={describe(self.package)}, exec={describe(self.executable)})"
 
 
+def rosl_executable(path: str | None = None) -> str | None:
+    """The ``rosl`` command (on the PATH, or beside this Python), which takes ``ros2``'s words."""
+    import shutil
+    import sys
+    from pathlib import Path
+
+    beside = Path(sys.executable).with_name("rosl")
+    if beside.is_file() and os.access(beside, os.X_OK):
+        return str(beside)
+    return shutil.which("rosl", path=path)
+
+
 class FindExecutable(Substitution):
-    """The path of an executable found on the PATH (``$(find-exec NAME)``)."""
+    """The path of an executable found on the PATH (``$(find-exec NAME)``).
+
+    Where no ``ros2`` is installed, ``FindExecutable(name='ros2')`` is rosl's own command, so a
+    launch file's ``ros2 ...`` commands run rosl's same words.
+    """
 
     def __init__(self, *, name: SomeSubstitutions) -> None:
         self.name = name
@@ -209,6 +225,8 @@ class FindExecutable(Substitution):
         name = perform(context, self.name)
         path = context.scope.environment.get("PATH", os.environ.get("PATH"))
         found = shutil.which(name, path=path)
+        if found is None and name == "ros2":  # no ROS 2 here: rosl says the same words
+            found = rosl_executable(path)
         if found is None:
             raise LaunchError(f"executable '{name}' not found on the PATH")
         return found
@@ -385,6 +403,42 @@ class Command(Substitution):
     def describe(self) -> str:
         """``Command(...)``."""
         return f"Command({describe(self.command)})"
+
+
+class LocalSubstitution(Substitution):
+    """A value from the context's locals, as an event handler's actions see them.
+
+    ``LocalSubstitution('event.returncode')`` in the actions of an OnProcessExit handler is the
+    exit code of the process that ended (``event.action``, ``event.pid``, ...).
+    """
+
+    def __init__(self, expression: str, description: str | None = None) -> None:
+        self.expression = expression
+        self.description = description
+
+    def perform(self, context: LaunchContext) -> str:
+        """The expression's value, read from the locals."""
+        head, _, rest = self.expression.partition(".")
+        if head not in context.locals:
+            known = ", ".join(sorted(k for k in context.locals if k != "anon")) or "none"
+            raise LaunchError(
+                f"LocalSubstitution('{self.expression}'): no local '{head}' here (locals: "
+                f"{known}; 'event' exists only in the actions of an event handler)"
+            )
+        value = context.locals[head]
+        for name in rest.split(".") if rest else []:
+            try:
+                value = value[name] if isinstance(value, dict) else getattr(value, name)
+            except (AttributeError, KeyError):
+                raise LaunchError(
+                    f"LocalSubstitution('{self.expression}'): {type(value).__name__} has no "
+                    f"'{name}'"
+                ) from None
+        return str(value)
+
+    def describe(self) -> str:
+        """``LocalVar('expression')``."""
+        return self.description or f"LocalVar('{self.expression}')"
 
 
 def _boolean(context: LaunchContext, value: SomeSubstitutions, what: str) -> bool:

@@ -80,6 +80,23 @@ class ProcessEvent:
     cmd: list[str] = field(default_factory=list)
     text: str = ""  # the line printed ("stdout"/"stderr" events), without its newline
 
+    @property
+    def process_name(self) -> str:
+        """The process's label (``talker-1``), as launch's process events name it."""
+        return self.name
+
+
+@dataclass(slots=True)
+class ExecutionComplete:
+    """An action has done its work (what OnExecutionComplete handlers see).
+
+    A process's action completes when the process has exited for good; a timer's when its
+    actions have run; any other action as soon as it has run.
+    """
+
+    action: Any
+    kind: str = "complete"
+
 
 @dataclass(slots=True)
 class ShutdownEvent:
@@ -146,9 +163,10 @@ class Supervisor:
         self._watch: tuple[str, str] | None = None
         self._seen = False
         self.watchers: list[Callable[[ProcessEvent], None]] = []  # see every launched process
-        self._started: list[tuple[ProcessEvent, LaunchContext]] = []  # for the handlers, next
+        self._started: list[tuple[ProcessEvent | ExecutionComplete, LaunchContext]] = []  # next
         self.keep_alive = False  # run() goes on after the last process, until a shutdown
         self._requests: list[str] = []  # shutdowns asked for by other threads
+        self._entities: list[tuple[list[Any], LaunchContext]] = []  # from other threads too
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -241,6 +259,9 @@ class Supervisor:
             os.set_blocking(pipe.fileno(), False)
             self._selector.register(pipe, selectors.EVENT_READ, running)
         self.log("INFO", label, f"process started with pid [{popen.pid}]")
+        with contextlib.suppress(AttributeError):  # as launch's ExecuteProcess has them
+            action.process_details = {"name": label, "cmd": list(spec.cmd), "pid": popen.pid,
+                                      "cwd": spec.cwd, "env": spec.env}  # fmt: skip
         started = ProcessEvent("start", action, label, popen.pid, None, spec.cmd)
         self._notify(running, started)
         if context is not None:  # handlers see it from the loop, as launch's event queue has it:
@@ -272,12 +293,47 @@ class Supervisor:
             for watcher in self.watchers:
                 watcher(event)
 
-    def _emit(self, event: ProcessEvent | ShutdownEvent, context: LaunchContext | None) -> None:
-        from rosl.launch.description import process
+    def _emit(
+        self,
+        event: ProcessEvent | ShutdownEvent | ExecutionComplete,
+        context: LaunchContext | None,
+    ) -> None:
+        from rosl.launch.description import process_for_event
 
         for handler, handler_context in list(self._handlers):
             if handler.matches(event):
-                process(handler.entities(event, handler_context or context), handler_context)
+                entities = handler.entities(event, handler_context or context)
+                process_for_event(entities, handler_context, event)
+
+    def completed(self, action: Any, context: LaunchContext) -> None:
+        """``action`` has done its work: the OnExecutionComplete handlers hear of it from the loop.
+
+        As launch's event queue has it: also those registered after the action.
+        """
+        self._started.append((ExecutionComplete(action), context))  # from the loop, in order
+
+    def request_entities(self, entities: list[Any], context: LaunchContext) -> None:
+        """Process launch entities on the supervising loop (from any thread)."""
+        self._entities.append((list(entities), context))
+
+    def shutdown_processes(self, matcher: Callable[[Any], bool]) -> None:
+        """Stop the processes whose action ``matcher`` accepts (SIGINT, then escalation)."""
+        for running in self._matching(matcher):
+            if not running.stopping:
+                self._signal(running, signal.SIGINT)
+
+    def signal_processes(self, matcher: Callable[[Any], bool], signum: int) -> None:
+        """Send ``signum`` to the processes whose action ``matcher`` accepts."""
+        for running in self._matching(matcher):
+            self.log("INFO", running.label, f"sending signal '{signal.Signals(signum).name}'")
+            try:
+                os.killpg(running.popen.pid, signum)
+            except (ProcessLookupError, PermissionError):
+                with contextlib.suppress(ProcessLookupError):
+                    running.popen.send_signal(signum)
+
+    def _matching(self, matcher: Callable[[Any], bool]) -> list[Running]:
+        return [r for r in self._running if r.action is not None and matcher(r.action)]
 
     # --- the loop ----------------------------------------------------------------------------
 
@@ -335,6 +391,11 @@ class Supervisor:
             self._handle_signal(self._signals.pop(0))
         while self._requests:
             self.shutdown(self._requests.pop(0))
+        while self._entities and self._shutdown_reason is None:
+            from rosl.launch.description import process
+
+            entities, context = self._entities.pop(0)
+            process(entities, context)
 
     def _handle_signal(self, signum: int) -> None:
         self._interrupts += 1
@@ -378,13 +439,18 @@ class Supervisor:
         self.loading = self._interrupt_pending = self._before_run = False
         try:
             self._handle_signals()  # any received while the launch file loaded
-            while self._running or (
-                self._shutdown_reason is None
-                and (self._timers or self._respawns or self.keep_alive)
+            while (
+                self._running
+                or self._started
+                or (
+                    self._shutdown_reason is None
+                    and (self._timers or self._respawns or self.keep_alive or self._entities)
+                )
             ):
                 self._handle_signals()
                 foreground = [r for r in self._running if not r.spec.background]
-                pending = self._timers or self._respawns or self.keep_alive
+                pending = (self._timers or self._respawns or self.keep_alive or self._started
+                           or self._entities)  # fmt: skip
                 if self._shutdown_reason is None and not foreground and not pending:
                     self.shutdown("all processes have finished")
                 if self._shutdown_reason is not None:
@@ -528,13 +594,15 @@ class Supervisor:
             on_exit = getattr(running.action, "on_exit", None)
             if on_exit is not None:  # ExecuteProcess(on_exit=...): a handler for itself
                 from rosl.launch.actions import OnProcessExit
-                from rosl.launch.description import process
+                from rosl.launch.description import process_for_event
 
                 own = OnProcessExit(target_action=running.action, on_exit=on_exit)
-                process(own.entities(event, running.context), running.context)
+                process_for_event(own.entities(event, running.context), running.context, event)
         if running.spec.respawn and self._shutdown_reason is None:
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip
+        elif running.context is not None:  # its work is done (a respawned one goes on)
+            self.completed(running.action, running.context)
 
     def kill_all(self) -> None:
         """Make sure nothing is left running (SIGKILL to every process group)."""

@@ -276,9 +276,9 @@ def test_real_component_and_lifecycle_launch_files_are_refused_in_one_line(
             "which rosl cannot: image_tools::Cam2Image",
         ),
         (
-            "launch.actions.EmitEvent(event=launch.events.process.ShutdownProcess())",
+            "launch.actions.ResetLaunchConfigurations()",
             6,
-            "'launch.events.process.ShutdownProcess' is not supported by rosl",
+            "'launch.actions.ResetLaunchConfigurations' is not supported by rosl",
         ),
         (
             "launch_ros.actions.Node(package='tutorial_pkg', executable='timer_node', "
