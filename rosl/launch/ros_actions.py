@@ -111,13 +111,17 @@ def parameter_value(context: LaunchContext, value: Any) -> Any:
     return resolve_value(context, value)
 
 
+_FOXY_NAMES = {"node_executable": "executable", "node_name": "name",
+               "node_namespace": "namespace"}  # fmt: skip
+
+
 class Node(ExecuteProcess):
     """Start a package's executable as a ROS node (launch_ros.actions.Node)."""
 
     def __init__(
         self,
         *,
-        executable: SomeSubstitutions,
+        executable: SomeSubstitutions = None,
         package: SomeSubstitutions = None,
         name: SomeSubstitutions = None,
         namespace: SomeSubstitutions = None,
@@ -128,6 +132,14 @@ class Node(ExecuteProcess):
         arguments: list[SomeSubstitutions] | None = None,
         **kwargs: Any,
     ) -> None:
+        old = sorted(k for k in kwargs if k in _FOXY_NAMES)
+        if old:
+            spelled = ", ".join(f"{k}= is now {_FOXY_NAMES[k]}=" for k in old)
+            raise LaunchError(
+                f"Node(): {spelled} (ROS 2 Dashing/Foxy's spelling, gone since Galactic)"
+            )
+        if executable is None:
+            raise LaunchError("Node() needs executable= (and package=)")
         super().__init__(cmd=[], **kwargs)
         self.package = package
         self.executable = executable

@@ -184,6 +184,11 @@ SUBSTITUTIONS: dict[str, _Factory] = {
     "not": (1, 1, lambda a, p: subs.NotSubstitution(a[0])),
     "and": (2, 2, lambda a, p: subs.AndSubstitution(a[0], a[1])),
     "or": (2, 2, lambda a, p: subs.OrSubstitution(a[0], a[1])),
+    "equals": (2, 2, lambda a, p: subs.EqualsSubstitution(a[0], a[1])),
+    "not-equals": (2, 2, lambda a, p: subs.NotEqualsSubstitution(a[0], a[1])),
+    "if": (2, 3, lambda a, p: subs.IfElseSubstitution(*a)),
+    "all": (1, 1 << 10, lambda a, p: subs.AllSubstitution(*a)),
+    "any": (1, 1 << 10, lambda a, p: subs.AnySubstitution(*a)),
 }
 
 
@@ -203,7 +208,7 @@ def instantiate(name: str, arguments: list[Any], path: Path | None) -> subs.Subs
     least, most, factory = SUBSTITUTIONS[name]
     if not least <= len(arguments) <= most:
         wanted = str(least) if least == most else f"{least} to {most}"
-        if most > 2:
+        if most >= 1 << 10:
             wanted = f"at least {least}"
         raise SubstitutionSyntaxError(f"$({name}) takes {wanted} argument(s), not {len(arguments)}")
     return factory(arguments, path)

@@ -359,9 +359,40 @@ class Supervisor:
         self._timers.clear()
         self._respawns.clear()
         self._emit(ShutdownEvent(reason, self._interrupts > 0), None)  # OnShutdown handlers
+        self._drain()
         for running in self._running:
-            if not running.spec.background:  # helpers (the recorder) stop after the rest
+            if running.spec.background:  # helpers (the recorder) stop after the rest
+                continue
+            if not self._ending_by_itself(running):
                 self._signal(running, signal.SIGINT)
+
+    def _drain(self) -> None:
+        """Read what the processes have printed so far (and which have closed their output)."""
+        for _ in range(100):  # bounded: a process printing without pause cannot hold us here
+            ready = self._selector.select(0)
+            if not ready:
+                return
+            for key, _ in ready:
+                self._read(cast("IO[bytes]", key.fileobj), key.data)
+
+    def _ending_by_itself(self, running: Running) -> bool:
+        """A process that has closed its stdout and stderr is exiting: let it (up to 1 s).
+
+        Else the SIGINT of a shutdown that comes just as it ends turns its clean exit into -2.
+        """
+        for pipe in (running.popen.stdout, running.popen.stderr):
+            if pipe is None:
+                continue
+            try:
+                self._selector.get_key(pipe)  # still open
+                return False
+            except KeyError:
+                continue
+        try:
+            running.popen.wait(timeout=1.0)
+        except subprocess.TimeoutExpired:
+            return False
+        return True
 
     def _signal(self, running: Running, signum: int) -> None:
         running.stopping = True

@@ -26,7 +26,7 @@ __all__ = [
 
 _SUBMODULES = frozenset(
     ("actions", "conditions", "event_handlers", "events", "launch_description_sources",
-     "substitutions", "utilities")
+     "logging", "substitutions", "utilities")
 )  # fmt: skip
 _unsupported = unsupported_names("launch", [*__all__, *sorted(_SUBMODULES)])
 

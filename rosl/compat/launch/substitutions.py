@@ -2,13 +2,18 @@
 
 from rosl.compat.unsupported import unsupported_names
 from rosl.launch.substitutions import (
+    AllSubstitution,
     AndSubstitution,
     AnonName,
+    AnySubstitution,
     Command,
     EnvironmentVariable,
+    EqualsSubstitution,
     FindExecutable,
+    IfElseSubstitution,
     LaunchConfiguration,
     LocalSubstitution,
+    NotEqualsSubstitution,
     NotSubstitution,
     OrSubstitution,
     PathJoinSubstitution,
@@ -19,13 +24,18 @@ from rosl.launch.substitutions import (
 )
 
 __all__ = [
+    "AllSubstitution",
     "AndSubstitution",
     "AnonName",
+    "AnySubstitution",
     "Command",
     "EnvironmentVariable",
+    "EqualsSubstitution",
     "FindExecutable",
+    "IfElseSubstitution",
     "LaunchConfiguration",
     "LocalSubstitution",
+    "NotEqualsSubstitution",
     "NotSubstitution",
     "OrSubstitution",
     "PathJoinSubstitution",

@@ -6,11 +6,11 @@ from typing import Any
 from rosl.compat.unsupported import unsupported_names
 from rosl.launch.testing.ros import WaitForTopics
 
-__all__ = ["WaitForTopics", "tools"]
+__all__ = ["WaitForTopics", "actions", "tools"]
 _unsupported = unsupported_names("launch_testing_ros", __all__)
 
 
 def __getattr__(name: str) -> Any:
-    if name == "tools":
-        return importlib.import_module("launch_testing_ros.tools")
+    if name in ("actions", "tools"):
+        return importlib.import_module(f"launch_testing_ros.{name}")
     return _unsupported(name)
