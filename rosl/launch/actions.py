@@ -92,6 +92,26 @@ class SetLaunchConfiguration(Action):
         context.launch_configurations[perform(context, self.name)] = perform(context, self.value)
 
 
+class ResetLaunchConfigurations(Action):
+    """Forget the launch configurations of this scope, but those given (name -> value)."""
+
+    def __init__(
+        self, launch_configurations: dict[SomeSubstitutions, SomeSubstitutions] | None = None,
+        **kwargs: Any,
+    ) -> None:  # fmt: skip
+        super().__init__(**kwargs)
+        self.launch_configurations = launch_configurations
+
+    def execute(self, context: LaunchContext) -> None:
+        """Clear the scope's configurations, then set the given ones."""
+        kept = {
+            perform(context, k): perform(context, v)
+            for k, v in (self.launch_configurations or {}).items()
+        }
+        context.launch_configurations.clear()
+        context.launch_configurations.update(kept)
+
+
 class SetEnvironmentVariable(Action):
     """Set an environment variable for processes started after it (in this scope)."""
 

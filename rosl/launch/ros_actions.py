@@ -15,7 +15,7 @@ import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rosl.launch.actions import ExecuteProcess
+from rosl.launch.actions import ExecuteProcess, TimerAction
 from rosl.launch.description import Action
 from rosl.launch.errors import LaunchError
 from rosl.launch.substitutions import (
@@ -169,9 +169,7 @@ class Node(ExecuteProcess):
         values: dict[str, Any] = {}  # every inline value (what --print and the details show)
         steps: list[dict[str, Any] | str] = []  # inline groups and user files, in order
         group: dict[str, Any] = {}
-        for name, value in context.scope.parameters:
-            group[perform(context, name)] = parameter_value(context, value)
-        for entry in self.parameters:
+        for entry in [*_scoped_parameters(context), *self.parameters]:
             if isinstance(entry, dict):
                 for key, value in entry.items():
                     group[perform(context, key)] = parameter_value(context, value)
@@ -269,9 +267,7 @@ class Node(ExecuteProcess):
         self, context: LaunchContext
     ) -> tuple[list[str], dict[str, Any]]:
         values: dict[str, Any] = {}
-        for name, value in context.scope.parameters:
-            values[perform(context, name)] = parameter_value(context, value)
-        for entry in self.parameters:
+        for entry in [*_scoped_parameters(context), *self.parameters]:
             if isinstance(entry, dict):
                 values.update(
                     {perform(context, k): parameter_value(context, v) for k, v in entry.items()}
@@ -279,6 +275,14 @@ class Node(ExecuteProcess):
             else:
                 values[f"(file) {_parameter_file(context, entry)}"] = "..."
         return [], values
+
+
+def _scoped_parameters(context: LaunchContext) -> list[Any]:
+    """SetParameter's values (as one-entry dicts) and SetParametersFromFile's files, in order."""
+    return [
+        entry if isinstance(entry, ParameterFile) else {entry[0]: entry[1]}
+        for entry in context.scope.parameters
+    ]
 
 
 def _parameter_file(context: LaunchContext, entry: Any) -> Path:
@@ -310,6 +314,29 @@ class SetParameter(Action):
     def execute(self, context: LaunchContext) -> None:
         """Record it on the current scope."""
         context.scope.parameters.append((self.name, self.value))
+
+
+class SetParametersFromFile(Action):
+    """Give a parameter file to every node started after it (in this scope), before its own."""
+
+    def __init__(self, filename: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.filename = filename
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record it on the current scope."""
+        context.scope.parameters.append(ParameterFile(perform(context, self.filename)))
+
+
+class SetUseSimTime(SetParameter):
+    """``use_sim_time`` for every node started after it (in this scope)."""
+
+    def __init__(self, value: Any, **kwargs: Any) -> None:
+        super().__init__("use_sim_time", value, **kwargs)
+
+
+class RosTimer(TimerAction):
+    """Run actions after a period (launch_ros.actions.RosTimer; rosl times it by the wall clock)."""
 
 
 class SetRemap(Action):

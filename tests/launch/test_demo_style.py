@@ -174,3 +174,101 @@ def test_a_foxy_era_node_argument_is_one_line_with_its_new_name(
         f"{path}:5: Node(): node_executable= is now executable= (ROS 2 Dashing/Foxy's spelling, "
         "gone since Galactic)"
     )
+
+
+SCOPED = """
+from launch import LaunchDescription
+from launch.actions import GroupAction, LogInfo, ResetLaunchConfigurations, SetLaunchConfiguration
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, RosTimer, SetParameter, SetParametersFromFile, SetUseSimTime
+
+def generate_launch_description():
+    return LaunchDescription([
+        SetLaunchConfiguration("a", "1"),
+        SetLaunchConfiguration("b", "2"),
+        GroupAction([
+            ResetLaunchConfigurations({"c": LaunchConfiguration("a")}),
+            LogInfo(msg=["c=", LaunchConfiguration("c"), " b=",
+                         LaunchConfiguration("b", default="gone")]),
+        ]),
+        LogInfo(msg=["outside b=", LaunchConfiguration("b")]),
+        GroupAction([
+            SetUseSimTime(True),
+            SetParametersFromFile(PARAMS),
+            SetParameter("after", 2),
+            Node(package="tutorial_pkg", executable="timer_node", parameters=[{"own": 3}]),
+        ]),
+        RosTimer(period=0.2, actions=[LogInfo(msg="ros timer fired")]),
+    ])
+"""
+
+
+def test_reset_configurations_parameters_from_file_sim_time_and_ros_timer(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    params = launch_dir / "params.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    from_file: 1\n")
+    path = write_launch(launch_dir, "scoped.launch.py", f"PARAMS = {str(params)!r}\n{SCOPED}")
+
+    code, out, err = rosl.run("launch", "--print", str(path))
+
+    assert code == 0, f"{out}\n{err}"
+    command = next(line for line in out.splitlines() if line.startswith("[timer_node-1]"))
+    assert "-p use_sim_time:=true -p after:=2 -p own:=3" in command, out
+    assert command.endswith(f"--params-file {params}"), out
+    assert "[timer_node-1]" in out
+    said = [line.split("]: ", 1)[1] for line in out.splitlines() if "[launch.user]" in line]
+    assert said == ["c=1 b=gone", "outside b=2"], out  # the timer never fires in --print
+    timer = write_launch(
+        launch_dir,
+        "ros_timer.launch.py",
+        """
+        from launch import LaunchDescription
+        from launch.actions import LogInfo
+        from launch_ros.actions import RosTimer
+        def generate_launch_description():
+            return LaunchDescription([RosTimer(period=0.2, actions=[LogInfo(msg="fired")])])
+        """,
+    )
+    code, out, err = rosl.run("launch", str(timer))
+    assert code == 0, f"{out}\n{err}"
+    assert "[INFO] [launch.user]: fired" in out, out
+
+
+TYPED_SETUP = """
+from launch import LaunchDescription
+from launch.action import Action
+from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.launch_context import LaunchContext
+from launch.launch_description import LaunchDescription as Description
+from launch.some_substitutions_type import SomeSubstitutionsType
+from launch.substitution import Substitution
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def launch_setup(context: LaunchContext, *args, **kwargs) -> list[Action]:
+    robots = int(LaunchConfiguration("robots").perform(context))
+    prefix: SomeSubstitutionsType = context.launch_configurations["prefix"]
+    return [Node(package="tutorial_pkg", executable="timer_node", name=f"timer_{i}",
+                 namespace=f"{prefix}{i}") for i in range(robots)]
+
+
+def generate_launch_description() -> Description:
+    assert issubclass(LaunchConfiguration, Substitution)
+    return LaunchDescription([
+        DeclareLaunchArgument("robots", default_value="2"),
+        DeclareLaunchArgument("prefix", default_value="robot"),
+        OpaqueFunction(function=launch_setup),
+    ])
+"""
+
+
+def test_an_opaque_function_setup_typed_with_launchs_modules(rosl: Rosl, launch_dir: Path) -> None:
+    path = write_launch(launch_dir, "typed.launch.py", TYPED_SETUP)
+
+    code, out, err = rosl.run("launch", "--print", str(path), "robots:=3")
+
+    assert code == 0, f"{out}\n{err}"
+    found = re.findall(r"node: (timer_\d) \(package tutorial_pkg, namespace (/robot\d)\)", out)
+    assert found == [("timer_0", "/robot0"), ("timer_1", "/robot1"), ("timer_2", "/robot2")], out

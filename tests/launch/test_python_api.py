@@ -276,9 +276,9 @@ def test_real_component_and_lifecycle_launch_files_are_refused_in_one_line(
             "which rosl cannot: image_tools::Cam2Image",
         ),
         (
-            "launch.actions.ResetLaunchConfigurations()",
+            "launch.actions.ExecuteLocal(process_description=None)",
             6,
-            "'launch.actions.ResetLaunchConfigurations' is not supported by rosl",
+            "'launch.actions.ExecuteLocal' is not supported by rosl",
         ),
         (
             "launch_ros.actions.Node(package='tutorial_pkg', executable='timer_node', "

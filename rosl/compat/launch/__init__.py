@@ -25,8 +25,9 @@ __all__ = [
 ]
 
 _SUBMODULES = frozenset(
-    ("actions", "conditions", "event_handlers", "events", "launch_description_sources",
-     "logging", "substitutions", "utilities")
+    ("action", "actions", "condition", "conditions", "event_handler", "event_handlers", "events",
+     "launch_context", "launch_description", "launch_description_sources", "logging",
+     "some_substitutions_type", "substitution", "substitutions", "utilities")
 )  # fmt: skip
 _unsupported = unsupported_names("launch", [*__all__, *sorted(_SUBMODULES)])
 
