@@ -374,7 +374,7 @@ class ExecuteProcess(Action):
 
     def execute(self, context: LaunchContext) -> None:
         """Hand the process to the supervisor."""
-        from rosl.launch.supervisor import ProcessSpec
+        from rosl.launch.records import ProcessSpec
 
         if self.shell:  # named after its command, not after the shell (substituted once)
             words = self.words(context)

@@ -17,7 +17,7 @@ from rosl.launch.errors import LaunchError
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
-    from rosl.launch.supervisor import ProcessEvent
+    from rosl.launch.records import ProcessEvent
 
 
 @dataclass(frozen=True, slots=True)

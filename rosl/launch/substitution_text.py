@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING, Any
 
+from rosl.launch import logic_substitutions as logic
 from rosl.launch import substitutions as subs
 
 if TYPE_CHECKING:
@@ -181,14 +182,14 @@ SUBSTITUTIONS: dict[str, _Factory] = {
     "anon": (1, 1, lambda a, p: subs.AnonName(a[0])),
     "dirname": (0, 0, lambda a, p: subs.ThisLaunchFileDir(path=p)),
     "filename": (0, 0, lambda a, p: subs.ThisLaunchFile(path=p)),
-    "not": (1, 1, lambda a, p: subs.NotSubstitution(a[0])),
-    "and": (2, 2, lambda a, p: subs.AndSubstitution(a[0], a[1])),
-    "or": (2, 2, lambda a, p: subs.OrSubstitution(a[0], a[1])),
-    "equals": (2, 2, lambda a, p: subs.EqualsSubstitution(a[0], a[1])),
-    "not-equals": (2, 2, lambda a, p: subs.NotEqualsSubstitution(a[0], a[1])),
-    "if": (2, 3, lambda a, p: subs.IfElseSubstitution(*a)),
-    "all": (1, 1 << 10, lambda a, p: subs.AllSubstitution(*a)),
-    "any": (1, 1 << 10, lambda a, p: subs.AnySubstitution(*a)),
+    "not": (1, 1, lambda a, p: logic.NotSubstitution(a[0])),
+    "and": (2, 2, lambda a, p: logic.AndSubstitution(a[0], a[1])),
+    "or": (2, 2, lambda a, p: logic.OrSubstitution(a[0], a[1])),
+    "equals": (2, 2, lambda a, p: logic.EqualsSubstitution(a[0], a[1])),
+    "not-equals": (2, 2, lambda a, p: logic.NotEqualsSubstitution(a[0], a[1])),
+    "if": (2, 3, lambda a, p: logic.IfElseSubstitution(*a)),
+    "all": (1, 1 << 10, lambda a, p: logic.AllSubstitution(*a)),
+    "any": (1, 1 << 10, lambda a, p: logic.AnySubstitution(*a)),
 }
 
 

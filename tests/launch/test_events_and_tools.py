@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import sys
 import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING
 
@@ -18,7 +19,7 @@ from rosl.launch.testing.tools import (
     expect_output,
     expected_output_from_file,
 )
-from tests.launch.support import assert_all_gone, one_error_line, write_launch
+from tests.launch.support import Output, assert_all_gone, one_error_line, write_launch
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -414,6 +415,23 @@ def test_tools_and_parametrize_run_under_launch_test_with_a_junit_report(
     assert cases["test_launch_process"].find("failure") is None
 
 
+def test_pytest_runs_each_value_of_a_parametrized_launch_test(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    path = write_launch(launch_dir, "test_tools.py", TOOLS_TEST)
+    command = [sys.executable, "-m", "pytest", "-s", "-p", "no:cacheprovider", str(path)]
+    output = Output(rosl.processes.start(command, cwd=launch_dir))
+    rosl.watched.append(output)
+
+    code = output.finish(180)
+
+    text = output.both()
+    assert code == 1, text
+    assert "1 failed: TestTools.test_fails_for_beta" in text, text
+    assert text.count("test_launch_process (test_tools.TestTools.test_launch_process) ... ok") == 2
+    assert_all_gone(output.pids())
+
+
 def test_junit_report_of_a_launch_that_ended_early_holds_the_problem(
     rosl: Rosl, launch_dir: Path
 ) -> None:
@@ -443,6 +461,32 @@ def test_junit_report_of_a_launch_that_ended_early_holds_the_problem(
     root = ET.parse(report).getroot()
     errors = [e.get("message") for e in root.iter("error")]
     assert errors == ["Processes under test stopped before tests completed"], ET.tostring(root)
+
+
+def test_an_unwritable_junit_report_is_one_line(rosl: Rosl, launch_dir: Path) -> None:
+    path = write_launch(
+        launch_dir,
+        "test_quick.py",
+        """
+        import unittest
+        import launch
+        import launch_testing.actions
+        def generate_test_description():
+            return launch.LaunchDescription([launch_testing.actions.ReadyToTest()])
+        class TestNothing(unittest.TestCase):
+            def test_nothing(self):
+                pass
+        """,
+    )
+    blocker = launch_dir / "a_file"
+    blocker.write_text("")
+
+    code, out, err = rosl.run("launch_test", str(path), "--junit-xml", str(blocker / "r.xml"))
+
+    assert code == 1, f"{out}\n{err}"
+    assert "Traceback" not in err, err  # unittest's report, then the one line
+    last = err.strip().splitlines()[-1]
+    assert last.startswith(f"cannot write the JUnit report {blocker}/r.xml: "), err
 
 
 def test_expect_output_matches_lines_and_text_as_launch_testing_does() -> None:

@@ -1,21 +1,23 @@
 """launch.substitutions."""
 
 from rosl.compat.unsupported import unsupported_names
-from rosl.launch.substitutions import (
+from rosl.launch.logic_substitutions import (
     AllSubstitution,
     AndSubstitution,
-    AnonName,
     AnySubstitution,
-    Command,
-    EnvironmentVariable,
     EqualsSubstitution,
-    FindExecutable,
     IfElseSubstitution,
-    LaunchConfiguration,
-    LocalSubstitution,
     NotEqualsSubstitution,
     NotSubstitution,
     OrSubstitution,
+)
+from rosl.launch.substitutions import (
+    AnonName,
+    Command,
+    EnvironmentVariable,
+    FindExecutable,
+    LaunchConfiguration,
+    LocalSubstitution,
     PathJoinSubstitution,
     PythonExpression,
     TextSubstitution,

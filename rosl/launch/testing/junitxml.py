@@ -68,11 +68,19 @@ def write_report(path: Path, name: str, runs: list[tuple[str, RunResult]]) -> No
         path: the XML file to write.
         name: ``PKG.FILE``, the ``<testsuites>`` name.
         runs: (suite name, result) of each launch.
+
+    Raises:
+        LaunchError: the file cannot be written (one line naming it).
     """
     root = ET.Element("testsuites", name=name)
     suites = [suite(suite_name, run) for suite_name, run in runs]
     for key in ("tests", "failures", "errors"):
         root.set(key, str(sum(int(s.get(key, "0")) for s in suites)))
     root.extend(suites)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    except OSError as err:
+        from rosl.launch.errors import LaunchError
+
+        raise LaunchError(f"cannot write the JUnit report {path}: {err.strerror}") from None

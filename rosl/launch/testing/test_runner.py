@@ -26,7 +26,8 @@ from rosl.launch.testing.proc_info_handler import (
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
-    from rosl.launch.supervisor import ProcessEvent, Supervisor
+    from rosl.launch.records import ProcessEvent
+    from rosl.launch.supervisor import Supervisor
     from rosl.launch.testing.loader import TestRun
 
 DIED = "Processes under test stopped before tests completed"
