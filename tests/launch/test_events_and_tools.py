@@ -415,9 +415,7 @@ def test_tools_and_parametrize_run_under_launch_test_with_a_junit_report(
     assert cases["test_launch_process"].find("failure") is None
 
 
-def test_pytest_runs_each_value_of_a_parametrized_launch_test(
-    rosl: Rosl, launch_dir: Path
-) -> None:
+def test_pytest_runs_each_value_of_a_parametrized_launch_test(rosl: Rosl, launch_dir: Path) -> None:
     path = write_launch(launch_dir, "test_tools.py", TOOLS_TEST)
     command = [sys.executable, "-m", "pytest", "-s", "-p", "no:cacheprovider", str(path)]
     output = Output(rosl.processes.start(command, cwd=launch_dir))
