@@ -304,6 +304,8 @@ class ExecuteProcess(Action):
         output: str = "log",
         respawn: bool | SomeSubstitutions = False,
         respawn_delay: float | None = None,
+        respawn_max_retries: int = -1,
+        cached_output: bool = False,
         emulate_tty: bool = False,
         sigterm_timeout: SomeSubstitutions = None,
         sigkill_timeout: SomeSubstitutions = None,
@@ -322,6 +324,8 @@ class ExecuteProcess(Action):
         self.output = output
         self.respawn = respawn
         self.respawn_delay = respawn_delay or 0.0
+        self.respawn_max_retries = int(respawn_max_retries)  # -1: no limit
+        del cached_output  # every line reaches the handlers as it comes
         self.emulate_tty = emulate_tty
         self.sigterm_timeout = sigterm_timeout
         self.sigkill_timeout = sigkill_timeout
@@ -390,6 +394,7 @@ class ExecuteProcess(Action):
             output=str(perform(context, self.output)),
             respawn=_flag(context, self.respawn),
             respawn_delay=float(self.respawn_delay),
+            respawn_max_retries=self.respawn_max_retries,
             emulate_tty=self.emulate_tty,
             sigterm_timeout=_seconds(context, self.sigterm_timeout, "sigterm_timeout"),
             sigkill_timeout=_seconds(context, self.sigkill_timeout, "sigkill_timeout"),

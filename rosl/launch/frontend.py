@@ -183,6 +183,13 @@ def _number(entity: Entity, name: str) -> float | None:
     return number
 
 
+def _count(entity: Entity, name: str) -> int | None:
+    number = _number(entity, name)
+    if number is not None and number != int(number):
+        raise entity.fail(f"attribute '{name}' of {entity.label} must be a whole number")
+    return None if number is None else int(number)
+
+
 def _key(value: Any) -> Any:
     return tuple(value) if isinstance(value, list) else value
 
@@ -243,8 +250,8 @@ def command_words(entity: Entity, name: str) -> list[Any] | None:
 _NAME_VALUE = _tag("name value")
 _PARAM = _tag("name value type from allow_substs", "param")
 _PROCESS = (
-    "cwd name launch-prefix output respawn respawn_delay shell emulate_tty sigterm_timeout "
-    "sigkill_timeout on_exit"
+    "cwd name launch-prefix output respawn respawn_delay respawn_max_retries shell emulate_tty "
+    "sigterm_timeout sigkill_timeout on_exit"
 )
 TAGS: dict[str, Tag] = {
     "arg": _tag("name default description", "choice"),
@@ -345,6 +352,7 @@ def _process(entity: Entity) -> dict[str, Any]:
         "output": _text(entity, "output"),
         "respawn": _flag(entity, "respawn", substitutions=True),
         "respawn_delay": _number(entity, "respawn_delay"),
+        "respawn_max_retries": _count(entity, "respawn_max_retries"),
         "shell": _flag(entity, "shell"),
         "emulate_tty": _flag(entity, "emulate_tty"),
         "sigterm_timeout": _text(entity, "sigterm_timeout"),

@@ -21,6 +21,7 @@ class ProcessSpec:
     output: str = "log"
     respawn: bool = False
     respawn_delay: float = 0.0
+    respawn_max_retries: int = -1  # -1: respawn without limit
     emulate_tty: bool = False
     sigterm_timeout: float = 5.0
     sigkill_timeout: float = 5.0

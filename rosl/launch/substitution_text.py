@@ -185,6 +185,8 @@ SUBSTITUTIONS: dict[str, _Factory] = {
     "not": (1, 1, lambda a, p: logic.NotSubstitution(a[0])),
     "and": (2, 2, lambda a, p: logic.AndSubstitution(a[0], a[1])),
     "or": (2, 2, lambda a, p: logic.OrSubstitution(a[0], a[1])),
+    "file-content": (1, 1, lambda a, p: subs.FileContent(a[0])),
+    "launch-log-dir": (0, 0, lambda a, p: subs.LaunchLogDir()),
     "equals": (2, 2, lambda a, p: logic.EqualsSubstitution(a[0], a[1])),
     "not-equals": (2, 2, lambda a, p: logic.NotEqualsSubstitution(a[0], a[1])),
     "if": (2, 3, lambda a, p: logic.IfElseSubstitution(*a)),

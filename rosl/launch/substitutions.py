@@ -103,11 +103,18 @@ class EnvironmentVariable(Substitution):
         return f"EnvVar({describe(self.name)})"
 
 
+class SubstitutionFailure(LaunchError):  # noqa: N818 - launch's name
+    """A substitution that cannot be performed (launch.substitutions.SubstitutionFailure)."""
+
+
 class PathJoinSubstitution(Substitution):
-    """Join path parts (each may be a substitution)."""
+    """Join path parts (each may be a substitution); ``/`` joins one more (launch since Jazzy)."""
 
     def __init__(self, substitutions: list[SomeSubstitutions]) -> None:
         self.substitutions = list(substitutions)
+
+    def __truediv__(self, other: SomeSubstitutions) -> PathJoinSubstitution:
+        return PathJoinSubstitution([*self.substitutions, other])
 
     def perform(self, context: LaunchContext) -> str:
         """The joined path."""
@@ -116,6 +123,49 @@ class PathJoinSubstitution(Substitution):
     def describe(self) -> str:
         """The parts joined with '/'."""
         return " + '/' + ".join(describe(part) for part in self.substitutions)
+
+
+class PathSubstitution(PathJoinSubstitution):
+    """A path to build on with ``/``: ``PathSubstitution(FindPackageShare('p')) / 'config'``."""
+
+    def __init__(self, path: SomeSubstitutions) -> None:
+        super().__init__([path])
+
+
+class FileContent(Substitution):
+    """The text of a file (``$(file-content PATH)``, launch since Jazzy)."""
+
+    def __init__(self, path: SomeSubstitutions) -> None:
+        self.path = path
+
+    def perform(self, context: LaunchContext) -> str:
+        """The file's text."""
+        path = perform(context, self.path)
+        try:
+            with open(path, encoding="utf-8") as file:
+                return file.read()
+        except (OSError, UnicodeDecodeError) as err:
+            why = err.strerror if isinstance(err, OSError) else "not UTF-8 text"
+            raise SubstitutionFailure(f"cannot read file {path}: {why}") from None
+
+    def describe(self) -> str:
+        """``FileContent(path)``."""
+        return f"FileContent({describe(self.path)})"
+
+
+class LaunchLogDir(Substitution):
+    """The launch's log folder (``$(launch-log-dir)``)."""
+
+    def perform(self, context: LaunchContext) -> str:
+        """The folder the launcher logs to."""
+        supervisor = context.supervisor
+        if supervisor is None:
+            raise SubstitutionFailure("LaunchLogDir used outside of a running launch")
+        return str(supervisor.log_dir)
+
+    def describe(self) -> str:
+        """``LaunchLogDir()``."""
+        return "LaunchLogDir()"
 
 
 class FindPackage(Substitution):

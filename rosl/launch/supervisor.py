@@ -92,6 +92,7 @@ class Supervisor:
         self._timers: list[tuple[float, int, Callable[[], None]]] = []
         self._timer_ids = itertools.count()
         self._respawns: list[tuple[float, int, ProcessSpec, Any, LaunchContext | None, str]] = []
+        self._respawned: dict[str, int] = {}  # label -> times respawned
         self._selector = selectors.DefaultSelector()
         self._shutdown_reason: str | None = None
         self._log_file: IO[str] | None = None
@@ -572,7 +573,10 @@ class Supervisor:
 
                 own = OnProcessExit(target_action=running.action, on_exit=on_exit)
                 process_for_event(own.entities(event, running.context), running.context, event)
-        if running.spec.respawn and self._shutdown_reason is None:
+        retries = running.spec.respawn_max_retries
+        if (running.spec.respawn and self._shutdown_reason is None
+                and (retries < 0 or self._respawned.get(running.label, 0) < retries)):  # fmt: skip
+            self._respawned[running.label] = self._respawned.get(running.label, 0) + 1
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip
         elif running.context is not None:  # its work is done (a respawned one goes on)

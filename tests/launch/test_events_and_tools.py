@@ -517,3 +517,80 @@ def test_basic_output_filter_and_expected_output_files(tmp_path: Path) -> None:
     assert expect_output("one\ntwo", expected_lines=patterns, strict=True)
     with pytest.raises(RuntimeError, match="could not find output check file"):
         expected_output_from_file(str(tmp_path / "missing"))
+
+
+@pytest.mark.parametrize("suffix", ["xml", "py"])
+def test_respawn_stops_after_respawn_max_retries(rosl: Rosl, launch_dir: Path, suffix: str) -> None:
+    source = (
+        '<launch>\n  <executable cmd="echo once more" output="screen" respawn="true"'
+        ' respawn_delay="0.1" respawn_max_retries="2"/>\n</launch>\n'
+        if suffix == "xml"
+        else """
+        from launch import LaunchDescription
+        from launch.actions import ExecuteProcess
+        def generate_launch_description():
+            return LaunchDescription([ExecuteProcess(
+                cmd=["echo", "once more"], output="screen", respawn=True, respawn_delay=0.1,
+                respawn_max_retries=2, cached_output=True)])
+        """
+    )
+    path = write_launch(launch_dir, f"respawn.launch.{suffix}", source)
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 0, f"{out}\n{err}"
+    assert out.count("[echo-1] once more") == 3, out  # the first run and two retries
+
+
+def test_file_content_path_substitution_and_launch_log_dir(
+    rosl: Rosl, launch_dir: Path, log_dir: Path
+) -> None:
+    (launch_dir / "config").mkdir()
+    (launch_dir / "config" / "motd.txt").write_text("hello from a file")
+    path = write_launch(
+        launch_dir,
+        "content.launch.py",
+        """
+        from launch import LaunchDescription
+        from launch.actions import LogInfo
+        from launch.substitutions import (FileContent, LaunchLogDir, PathSubstitution,
+                                          ThisLaunchFileDir)
+        def generate_launch_description():
+            motd = PathSubstitution(ThisLaunchFileDir()) / "config" / "motd.txt"
+            return LaunchDescription([
+                LogInfo(msg=["python: ", FileContent(motd)]),
+                LogInfo(msg=["log dir: ", LaunchLogDir()]),
+            ])
+        """,
+    )
+    xml = write_launch(
+        launch_dir,
+        "content.launch.xml",
+        '<launch>\n  <log message="xml: $(file-content $(dirname)/config/motd.txt)"/>\n</launch>\n',
+    )
+
+    code, out, err = rosl.run("launch", str(path))
+    xml_code, xml_out, xml_err = rosl.run("launch", str(xml))
+
+    assert code == 0, f"{out}\n{err}"
+    assert "[INFO] [launch.user]: python: hello from a file" in out, out
+    logged = re.search(r"\[launch\.user\]: log dir: (\S+)", out)
+    assert logged is not None, out
+    assert logged.group(1).startswith(str(log_dir)), out
+    assert xml_code == 0, f"{xml_out}\n{xml_err}"
+    assert "[INFO] [launch.user]: xml: hello from a file" in xml_out, xml_out
+
+
+def test_a_missing_file_content_is_one_line_at_its_tag(rosl: Rosl, launch_dir: Path) -> None:
+    path = write_launch(
+        launch_dir,
+        "missing.launch.xml",
+        '<launch>\n  <log message="$(file-content /no/such/file.txt)"/>\n</launch>\n',
+    )
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 1, f"{out}\n{err}"
+    assert one_error_line(err) == (
+        f"{path}:2: cannot read file /no/such/file.txt: No such file or directory"
+    )
