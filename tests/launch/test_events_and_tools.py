@@ -594,3 +594,45 @@ def test_a_missing_file_content_is_one_line_at_its_tag(rosl: Rosl, launch_dir: P
     assert one_error_line(err) == (
         f"{path}:2: cannot read file /no/such/file.txt: No such file or directory"
     )
+
+
+SERVICE = """
+import sys
+import threading
+
+import rosl.compat
+
+rosl.compat.install()
+import launch
+from launch.actions import DeclareLaunchArgument, ExecuteProcess, LogInfo
+from launch.substitutions import LaunchConfiguration
+
+service = launch.LaunchService(argv=sys.argv[1:])
+service.include_launch_description(launch.LaunchDescription([
+    DeclareLaunchArgument("word", default_value="unset"),
+    LogInfo(msg=["word is ", LaunchConfiguration("word")]),
+    ExecuteProcess(cmd=["echo", "from the service"], output="screen"),
+]))
+print("first run:", service.run(), flush=True)
+second = launch.LaunchService()
+second.include_launch_description(launch.LaunchDescription([ExecuteProcess(cmd=["sleep", "60"])]))
+threading.Timer(1.0, second.shutdown).start()
+print("second run:", second.run(), flush=True)
+"""
+
+
+def test_launch_service_runs_a_description_from_a_program(rosl: Rosl, launch_dir: Path) -> None:
+    script = write_launch(launch_dir, "service.py", SERVICE)
+    output = Output(rosl.processes.start([sys.executable, str(script), "word:=hi"]))
+    rosl.watched.append(output)
+
+    code = output.finish(60)
+
+    out = output.text()
+    assert code == 0, output.both()
+    assert "[INFO] [launch.user]: word is hi" in out, out
+    assert "[echo-1] from the service" in out, out
+    assert "first run: 0" in out, out
+    assert re.search(r"\[sleep-1\]: process has died \[pid \d+, exit code -2", out), out
+    assert "second run: 0" in out, out
+    assert_all_gone(output.pids())

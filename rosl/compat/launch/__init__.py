@@ -11,6 +11,7 @@ from rosl.compat.unsupported import unsupported_names
 from rosl.launch.context import LaunchContext
 from rosl.launch.description import Action, Condition, LaunchDescription
 from rosl.launch.event_handlers import EventHandler
+from rosl.launch.service import LaunchService
 from rosl.launch.substitutions import SomeSubstitutions as SomeSubstitutionsType
 from rosl.launch.substitutions import Substitution
 
@@ -20,6 +21,7 @@ __all__ = [
     "EventHandler",
     "LaunchContext",
     "LaunchDescription",
+    "LaunchService",
     "SomeSubstitutionsType",
     "Substitution",
 ]
