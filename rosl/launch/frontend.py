@@ -270,6 +270,10 @@ TAGS: dict[str, Tag] = {
     "node": _tag(f"pkg exec namespace exec_name args ros_args {_PROCESS}", "param remap env"),
     "set_parameter": _tag("name value"),
     "set_remap": _tag("from to"),
+    "set_parameters_from_file": _tag("filename"),
+    "set_use_sim_time": _tag("value"),
+    "reset": _tag("", "keep"),
+    "ros_timer": _tag("period", children=True),
 }
 _NESTED = {
     "choice": _tag("value"),
@@ -506,6 +510,19 @@ BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "set_parameter": _set_parameter,
     "set_remap": lambda e: ros_actions.SetRemap(
         _text(e, "from", required=True), _text(e, "to", required=True), **_condition(e)
+    ),
+    "set_parameters_from_file": lambda e: ros_actions.SetParametersFromFile(
+        _text(e, "filename", required=True), **_condition(e)
+    ),
+    "set_use_sim_time": lambda e: ros_actions.SetUseSimTime(
+        _flag(e, "value", substitutions=True) if e.value("value") is not None else True,
+        **_condition(e),
+    ),
+    "reset": lambda e: actions.ResetLaunchConfigurations(
+        dict(_name_values(e, "keep")) or None, **_condition(e)
+    ),
+    "ros_timer": lambda e: ros_actions.RosTimer(
+        period=_text(e, "period", required=True), actions=_child_actions(e), **_condition(e)
     ),
 }
 BUILDERS["push_ros_namespace"] = BUILDERS["push-ros-namespace"]

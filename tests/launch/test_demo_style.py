@@ -272,3 +272,37 @@ def test_an_opaque_function_setup_typed_with_launchs_modules(rosl: Rosl, launch_
     assert code == 0, f"{out}\n{err}"
     found = re.findall(r"node: (timer_\d) \(package tutorial_pkg, namespace (/robot\d)\)", out)
     assert found == [("timer_0", "/robot0"), ("timer_1", "/robot1"), ("timer_2", "/robot2")], out
+
+
+def test_reset_parameters_from_file_sim_time_and_ros_timer_tags_in_xml(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    params = launch_dir / "params.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    from_file: 1\n")
+    path = write_launch(
+        launch_dir,
+        "tags.launch.xml",
+        f"""
+        <launch>
+          <let name="a" value="1"/>
+          <let name="b" value="2"/>
+          <group>
+            <reset><keep name="c" value="$(var a)"/></reset>
+            <log message="c=$(var c) b=$(var b gone)"/>
+          </group>
+          <group>
+            <set_use_sim_time value="true"/>
+            <set_parameters_from_file filename="{params}"/>
+            <node pkg="tutorial_pkg" exec="timer_node"/>
+          </group>
+          <ros_timer period="0.1"><log message="ros timer"/></ros_timer>
+        </launch>
+        """,
+    )
+
+    code, out, err = rosl.run("launch", "--print", str(path))
+
+    assert code == 0, f"{out}\n{err}"
+    assert "[INFO] [launch.user]: c=1 b=gone" in out, out
+    command = next(line for line in out.splitlines() if line.startswith("[timer_node-1]"))
+    assert command.endswith(f"--ros-args -p use_sim_time:=true --params-file {params}"), out
