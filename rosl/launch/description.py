@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 import re
 import sys
+import sysconfig
+import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -28,6 +30,27 @@ def creation_site() -> str | None:
         if not name.startswith((_ROSL_DIR, "<")):
             return f"{name}:{frame.f_lineno}"
         frame = frame.f_back  # type: ignore[assignment]
+    return None
+
+
+_LIBRARIES = tuple(
+    {sysconfig.get_paths()[k] + os.sep for k in ("stdlib", "platstdlib", "purelib", "platlib")}
+)
+
+
+def user_error(err: BaseException) -> LaunchError | None:
+    """``file:line: Type: message`` when ``err`` was raised by a launch file's own code.
+
+    The innermost frame outside Python's and the installed libraries decides: a launch file's
+    (the user's mistake: one line), or rosl's (a bug: None, so its traceback is kept).
+    """
+    for frame in reversed(traceback.extract_tb(err.__traceback__)):
+        name = frame.filename
+        if name.startswith(_LIBRARIES) and not name.startswith(_ROSL_DIR):
+            continue
+        if name.startswith((_ROSL_DIR, "<")):
+            return None
+        return LaunchError(f"{name}:{frame.lineno}: {type(err).__name__}: {err}")
     return None
 
 
@@ -209,17 +232,32 @@ def process(entities: Iterable[Any], context: LaunchContext) -> None:
             more = entity.visit(context)
         except LaunchError as err:
             raise located(err, getattr(entity, "location", None), context) from None
+        except Exception as err:  # the user's own code (an OpaqueFunction's): one line
+            found = user_error(err)
+            if found is None:
+                raise  # rosl's own bug: keep its traceback
+            raise found from None
         if more:
             process(more, context)
         if context.supervisor is not None and not getattr(entity, "completes_later", False):
             context.supervisor.completed(entity, context)
 
 
-def process_for_event(entities: Iterable[Any], context: LaunchContext, event: Any) -> None:
-    """Process an event handler's entities with ``event`` among the context's locals.
+def process_for_event(handler: Any, event: Any, context: LaunchContext) -> None:
+    """Run an event handler: what it returns for ``event``, with ``event`` among the locals.
 
-    As launch does: ``LocalSubstitution('event.returncode')`` in them reads the event.
+    As launch does: ``LocalSubstitution('event.returncode')`` in its actions reads the event.
+    An exception raised by the user's handler function is one line naming its file and line.
     """
+    try:
+        entities = handler.entities(event, context)
+    except LaunchError:
+        raise
+    except Exception as err:
+        found = user_error(err)
+        if found is None:
+            raise
+        raise found from None
     had = "event" in context.locals
     previous = context.locals.get("event")
     context.locals["event"] = event

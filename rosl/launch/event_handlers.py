@@ -203,6 +203,6 @@ class RegisterEventHandler(Action):
 
         def watch(event: ProcessEvent) -> None:
             if handler.matches(event):
-                process_for_event(handler.entities(event, context), context, event)
+                process_for_event(handler, event, context)
 
         supervisor.watchers.append(watch)

@@ -246,8 +246,7 @@ class Supervisor:
 
         for handler, handler_context in list(self._handlers):
             if handler.matches(event):
-                entities = handler.entities(event, handler_context or context)
-                process_for_event(entities, handler_context, event)
+                process_for_event(handler, event, handler_context)
 
     def completed(self, action: Any, context: LaunchContext) -> None:
         """``action`` has done its work: the OnExecutionComplete handlers hear of it from the loop.
@@ -304,10 +303,11 @@ class Supervisor:
         self._respawns.clear()
         self._emit(ShutdownEvent(reason, self._interrupts > 0), None)  # OnShutdown handlers
         self._drain()
+        deadline = time.monotonic() + 1.0  # for all of them together
         for running in self._running:
             if running.spec.background:  # helpers (the recorder) stop after the rest
                 continue
-            if not self._ending_by_itself(running):
+            if not self._ending_by_itself(running, deadline):
                 self._signal(running, signal.SIGINT)
 
     def _drain(self) -> None:
@@ -319,8 +319,8 @@ class Supervisor:
             for key, _ in ready:
                 self._read(cast("IO[bytes]", key.fileobj), key.data)
 
-    def _ending_by_itself(self, running: Running) -> bool:
-        """A process that has closed its stdout and stderr is exiting: let it (up to 1 s).
+    def _ending_by_itself(self, running: Running, deadline: float) -> bool:
+        """A process that has closed its stdout and stderr is exiting: let it (until deadline).
 
         Else the SIGINT of a shutdown that comes just as it ends turns its clean exit into -2.
         """
@@ -333,7 +333,7 @@ class Supervisor:
             except KeyError:
                 continue
         try:
-            running.popen.wait(timeout=1.0)
+            running.popen.wait(timeout=max(0.0, deadline - time.monotonic()))
         except subprocess.TimeoutExpired:
             return False
         return True
@@ -572,7 +572,7 @@ class Supervisor:
                 from rosl.launch.description import process_for_event
 
                 own = OnProcessExit(target_action=running.action, on_exit=on_exit)
-                process_for_event(own.entities(event, running.context), running.context, event)
+                process_for_event(own, event, running.context)
         retries = running.spec.respawn_max_retries
         if (running.spec.respawn and self._shutdown_reason is None
                 and (retries < 0 or self._respawned.get(running.label, 0) < retries)):  # fmt: skip

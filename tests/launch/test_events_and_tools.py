@@ -636,3 +636,47 @@ def test_launch_service_runs_a_description_from_a_program(rosl: Rosl, launch_dir
     assert re.search(r"\[sleep-1\]: process has died \[pid \d+, exit code -2", out), out
     assert "second run: 0" in out, out
     assert_all_gone(output.pids())
+
+
+@pytest.mark.parametrize(
+    ("body", "line", "message"),
+    [
+        (
+            """
+            from launch import LaunchDescription
+            from launch.actions import OpaqueFunction
+            def setup(context):
+                return [1 / 0]
+            def generate_launch_description():
+                return LaunchDescription([OpaqueFunction(function=setup)])
+            """,
+            4,
+            "ZeroDivisionError: division by zero",
+        ),
+        (
+            """
+            from launch import LaunchDescription
+            from launch.actions import ExecuteProcess, RegisterEventHandler
+            from launch.event_handlers import OnProcessExit
+            def on_exit(event, context):
+                return {}["missing"]
+            def generate_launch_description():
+                p = ExecuteProcess(cmd=["true"])
+                return LaunchDescription([
+                    p, RegisterEventHandler(OnProcessExit(target_action=p, on_exit=on_exit))])
+            """,
+            5,
+            "KeyError: 'missing'",
+        ),
+    ],
+    ids=["opaque_function", "event_handler"],
+)
+def test_an_exception_in_the_launch_files_own_function_is_one_line_at_its_line(
+    rosl: Rosl, launch_dir: Path, body: str, line: int, message: str
+) -> None:
+    path = write_launch(launch_dir, "raises.launch.py", body)
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 1, f"{out}\n{err}"
+    assert one_error_line(err) == f"{path}:{line}: {message}"
