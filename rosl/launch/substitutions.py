@@ -502,6 +502,17 @@ def perform(context: LaunchContext, value: SomeSubstitutions) -> str:
     return str(value)
 
 
+def normalize(value: SomeSubstitutions) -> list[Substitution]:
+    """A value as a list of substitutions, text as TextSubstitution (launch.utilities')."""
+    if value is None:
+        return []
+    if isinstance(value, Substitution):
+        return [value]
+    if isinstance(value, (list, tuple)):
+        return [part for item in value for part in normalize(item)]
+    return [TextSubstitution(text=str(value))]
+
+
 def describe(value: SomeSubstitutions) -> str:
     """Describe unresolved text (for ``--show-args``)."""
     if value is None:

@@ -306,3 +306,49 @@ def test_reset_parameters_from_file_sim_time_and_ros_timer_tags_in_xml(
     assert "[INFO] [launch.user]: c=1 b=gone" in out, out
     command = next(line for line in out.splitlines() if line.startswith("[timer_node-1]"))
     assert command.endswith(f"--ros-args -p use_sim_time:=true --params-file {params}"), out
+
+
+CUSTOM = """
+import os
+
+from launch import LaunchDescription, Substitution
+from launch.actions import LogInfo
+from launch.launch_description_sources import get_launch_description_from_any_launch_file
+from launch.substitutions import LaunchConfiguration
+from launch.utilities import normalize_to_list_of_substitutions, perform_substitutions
+
+
+class Shout(Substitution):
+    def __init__(self, text):
+        super().__init__()
+        self.text = normalize_to_list_of_substitutions(text)
+
+    def perform(self, context):
+        return perform_substitutions(context, self.text).upper()
+
+
+def generate_launch_description():
+    inner = get_launch_description_from_any_launch_file(
+        os.path.join(os.path.dirname(__file__), "inner.launch.xml"))
+    return LaunchDescription([
+        inner,
+        LogInfo(msg=Shout(["hello ", LaunchConfiguration("who")])),
+    ])
+"""
+
+
+def test_a_custom_substitution_and_a_description_loaded_from_a_file(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    write_launch(
+        launch_dir,
+        "inner.launch.xml",
+        '<launch>\n  <let name="who" value="world"/>\n  <log message="inner"/>\n</launch>\n',
+    )
+    path = write_launch(launch_dir, "custom.launch.py", CUSTOM)
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 0, f"{out}\n{err}"
+    said = [line.split("]: ", 1)[1] for line in out.splitlines() if "[launch.user]" in line]
+    assert said == ["inner", "HELLO WORLD"], out
