@@ -400,9 +400,9 @@ def parameters(entity: Entity) -> list[Any]:
         if param.value("from") is not None:
             if param.value("name") is not None or param.nested("param"):
                 raise param.fail(f"{param.label} with 'from' has no 'name' and no nested params")
-            if _flag(param, "allow_substs"):
-                raise param.fail("rosl does not expand substitutions inside parameter files")
-            found.append(_text(param, "from"))
+            allow = _flag(param, "allow_substs", substitutions=True)
+            source = _text(param, "from")
+            found.append(ros_actions.ParameterFile(source, allow_substs=allow) if allow else source)
             continue
         if not found or not isinstance(found[-1], dict):
             found.append({})

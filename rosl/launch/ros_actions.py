@@ -43,15 +43,40 @@ class ParameterValue:
 
 
 class ParameterFile:
-    """A parameter file given to a Node (launch_ros.descriptions.ParameterFile)."""
+    """A parameter file given to a Node (launch_ros.descriptions.ParameterFile).
 
-    def __init__(self, param_file: SomeSubstitutions, *, allow_substs: bool = False) -> None:
-        if allow_substs:
-            raise LaunchError(
-                "ParameterFile(allow_substs=True) is not supported by rosl: substitutions "
-                "inside a parameter file are not expanded; pass the values as a dict instead"
-            )
+    With ``allow_substs`` the file's ``$(...)`` substitutions (``$(var x)``, ``$(env X)``, ...)
+    are performed first, and the node gets the substituted copy.
+    """
+
+    def __init__(
+        self, param_file: SomeSubstitutions, *, allow_substs: bool | SomeSubstitutions = False
+    ) -> None:
         self.param_file = param_file
+        self.allow_substs = allow_substs
+
+    def substituted(self, context: LaunchContext, path: Path, label: str) -> Path:
+        """The file to hand to the node: ``path``, or its substituted copy.
+
+        Raises:
+            LaunchError: a substitution in the file cannot be read or performed.
+        """
+        allow = self.allow_substs
+        if not isinstance(allow, bool):
+            allow = perform(context, allow).strip().lower() in ("true", "1", "yes", "on")
+        if not allow:
+            return path
+        from rosl.launch.substitution_text import SubstitutionSyntaxError, parse_substitution
+
+        try:
+            text = perform(context, parse_substitution(path.read_text(encoding="utf-8"), path=path))
+        except SubstitutionSyntaxError as err:
+            raise LaunchError(f"{path}: bad substitution: {err}") from None
+        except (OSError, UnicodeDecodeError) as err:
+            raise LaunchError(f"{path}: cannot read: {err}") from None
+        if context.supervisor is None:
+            return path
+        return context.supervisor.parameter_files.write_text(label, text)
 
 
 def yaml_typed(text: str) -> Any:
@@ -179,6 +204,8 @@ class Node(ExecuteProcess):
                     raise LaunchError(
                         f"parameter file {path} (for {self._label(context)}) does not exist"
                     )
+                if isinstance(entry, ParameterFile):
+                    path = entry.substituted(context, path, self._label(context))
                 if group:
                     steps.append(group)
                     group = {}
@@ -204,7 +231,7 @@ class Node(ExecuteProcess):
         elif supervisor is not None:
             for step in steps:
                 if isinstance(step, dict):
-                    step = str(supervisor.parameter_file(self._label(context), step))
+                    step = str(supervisor.parameter_files.write(self._label(context), step))
                 args += ["--params-file", step]
         return args, values
 

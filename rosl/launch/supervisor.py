@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, cast
 
 from rosl.launch.errors import LaunchError
+from rosl.launch.parameter_files import ParameterFiles
 from rosl.launch.records import ExecutionComplete, ProcessEvent, ProcessSpec, ShutdownEvent
 from rosl.pkg import interrupts
 
@@ -86,7 +87,7 @@ class Supervisor:
         self.failed: list[str] = []
         self.started = 0
         self._counter = itertools.count(1)
-        self._param_files = itertools.count(1)
+        self.parameter_files = ParameterFiles(self.log_dir, dry_run=dry_run)
         self._running: list[Running] = []
         self._handlers: list[tuple[Any, LaunchContext]] = []
         self._timers: list[tuple[float, int, Callable[[], None]]] = []
@@ -141,18 +142,6 @@ class Supervisor:
         if handle is not None:
             handle.write(f"{time.time():.7f} {line}\n")
             handle.flush()
-
-    def parameter_file(self, label: str, values: dict[str, Any]) -> Path:
-        """Write a node's parameters as a ROS 2 parameter file; return its path."""
-        import yaml
-
-        folder = self.log_dir / "params"
-        path = folder / f"{label.replace('/', '_')}-{next(self._param_files)}.yaml"
-        if self.dry_run:  # --print writes nothing
-            return path
-        folder.mkdir(parents=True, exist_ok=True)
-        path.write_text(yaml.safe_dump({"/**": {"ros__parameters": values}}), encoding="utf-8")
-        return path
 
     # --- starting ----------------------------------------------------------------------------
 

@@ -352,3 +352,64 @@ def test_a_custom_substitution_and_a_description_loaded_from_a_file(
     assert code == 0, f"{out}\n{err}"
     said = [line.split("]: ", 1)[1] for line in out.splitlines() if "[launch.user]" in line]
     assert said == ["inner", "HELLO WORLD"], out
+
+
+@pytest.mark.parametrize("suffix", ["py", "xml"])
+def test_a_parameter_file_with_substitutions_reaches_the_node_substituted(
+    rosl: Rosl, launch_dir: Path, suffix: str
+) -> None:
+    params = launch_dir / "timer.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    timer_period_s: $(var period)\n")
+    source = (
+        f"""
+        from launch import LaunchDescription
+        from launch.actions import DeclareLaunchArgument
+        from launch_ros.actions import Node
+        from launch_ros.descriptions import ParameterFile
+        def generate_launch_description():
+            return LaunchDescription([
+                DeclareLaunchArgument("period", default_value="2.0"),
+                Node(package="tutorial_pkg", executable="timer_node", output="screen",
+                     parameters=[ParameterFile({str(params)!r}, allow_substs=True)]),
+            ])
+        """
+        if suffix == "py"
+        else f"""
+        <launch>
+          <arg name="period" default="2.0"/>
+          <node pkg="tutorial_pkg" exec="timer_node" output="screen">
+            <param from="{params}" allow_substs="true"/>
+          </node>
+        </launch>
+        """
+    )
+    path = write_launch(launch_dir, f"substs.launch.{suffix}", source)
+    launch = rosl.start("launch", str(path), "period:=0.25")
+
+    assert launch.wait_for(r"\[timer_node-1\] .*Timer period: 0\.25 s", timeout=60), launch.both()
+    pids = launch.pids()
+    assert launch.interrupt() == 0, launch.both()
+    assert_all_gone(pids)
+
+
+def test_a_bad_substitution_in_a_parameter_file_is_one_line(rosl: Rosl, launch_dir: Path) -> None:
+    params = launch_dir / "bad.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    x: $(nope)\n")
+    path = write_launch(
+        launch_dir,
+        "bad_substs.launch.xml",
+        f"""
+        <launch>
+          <node pkg="tutorial_pkg" exec="timer_node">
+            <param from="{params}" allow_substs="true"/>
+          </node>
+        </launch>
+        """,
+    )
+
+    code, out, err = rosl.run("launch", str(path))
+
+    assert code == 1, f"{out}\n{err}"
+    assert one_error_line(err).startswith(
+        f"{path}:2: {params}: bad substitution: unknown substitution '$(nope)'"
+    ), err

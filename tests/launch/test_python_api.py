@@ -282,9 +282,9 @@ def test_real_component_and_lifecycle_launch_files_are_refused_in_one_line(
         ),
         (
             "launch_ros.actions.Node(package='tutorial_pkg', executable='timer_node', "
-            "parameters=[launch_ros.descriptions.ParameterFile('p.yaml', allow_substs=True)])",
+            "parameters=[42])",
             6,
-            "ParameterFile(allow_substs=True) is not supported by rosl",
+            "parameters of timer_node must be dicts or YAML file paths, not int",
         ),
         (
             "launch.actions.LogInfo(msg=get_package_share_directory('no_such_package'))",
