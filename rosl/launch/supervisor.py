@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, cast
 
-from rosl.launch.errors import LaunchError
 from rosl.launch.parameter_files import ParameterFiles
 from rosl.launch.records import ExecutionComplete, ProcessEvent, ProcessSpec, ShutdownEvent
 from rosl.pkg import interrupts
@@ -110,7 +109,7 @@ class Supervisor:
         self.watchers: list[Callable[[ProcessEvent], None]] = []  # see every launched process
         self._started: list[tuple[ProcessEvent | ExecutionComplete, LaunchContext]] = []  # next
         self.keep_alive = False  # run() goes on after the last process, until a shutdown
-        self._requests: list[str] = []  # shutdowns asked for by other threads
+        self._requests: list[tuple[str, float]] = []  # shutdowns asked for by other threads
         self._entities: list[tuple[list[Any], LaunchContext]] = []  # from other threads too
 
     # --- logging -----------------------------------------------------------------------------
@@ -279,12 +278,17 @@ class Supervisor:
         """Whether a SIGINT or SIGTERM reached the launcher."""
         return self._interrupts > 0
 
-    def request_shutdown(self, reason: str) -> None:
-        """Ask for ``shutdown(reason)`` from any thread; the supervising loop does it (≤ 0.1 s)."""
-        self._requests.append(reason)
+    def request_shutdown(self, reason: str, grace: float = 0.0) -> None:
+        """Ask for ``shutdown(reason, grace)`` from any thread; the supervising loop does it."""
+        self._requests.append((reason, grace))
 
-    def shutdown(self, reason: str) -> None:
-        """Stop every process (SIGINT, then escalation) and start nothing more."""
+    def shutdown(self, reason: str, grace: float = 0.0) -> None:
+        """Stop every process (SIGINT, then escalation) and start nothing more.
+
+        ``grace``: seconds the processes get to end by themselves first (their output is read
+        meanwhile); a launch test gives its processes a moment once its tests are done, so one
+        that prints and ends at once is not caught by the SIGINT.
+        """
         if self._shutdown_reason is not None:
             return
         self._shutdown_reason = reason
@@ -292,6 +296,7 @@ class Supervisor:
         self._respawns.clear()
         self._emit(ShutdownEvent(reason, self._interrupts > 0), None)  # OnShutdown handlers
         self._drain()
+        self._let_end(grace)
         deadline = time.monotonic() + 1.0  # for all of them together
         for running in self._running:
             if running.spec.background:  # helpers (the recorder) stop after the rest
@@ -306,6 +311,15 @@ class Supervisor:
             if not ready:
                 return
             for key, _ in ready:
+                self._read(cast("IO[bytes]", key.fileobj), key.data)
+
+    def _let_end(self, grace: float) -> None:
+        deadline = time.monotonic() + grace
+        while any(r.popen.poll() is None for r in self._running if not r.spec.background):
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return
+            for key, _ in self._selector.select(min(left, 0.02)):
                 self._read(cast("IO[bytes]", key.fileobj), key.data)
 
     def _ending_by_itself(self, running: Running, deadline: float) -> bool:
@@ -354,7 +368,7 @@ class Supervisor:
         while self._signals:
             self._handle_signal(self._signals.pop(0))
         while self._requests:
-            self.shutdown(self._requests.pop(0))
+            self.shutdown(*self._requests.pop(0))
         while self._entities and self._shutdown_reason is None:
             from rosl.launch.description import process
 
@@ -584,10 +598,3 @@ def _default_log_dir() -> Path:
     base = os.environ.get("ROSL_LOG_DIR") or os.path.join(os.path.expanduser("~"), ".rosl", "log")
     stamp = datetime.datetime.now().strftime("%Y-%m-%d-%H-%M-%S-%f")
     return Path(base) / f"{stamp}-{socket.gethostname()}-{os.getpid()}"
-
-
-def check_output(value: str) -> str:
-    """Validate an ``output=`` value."""
-    if value not in ("screen", "log", "both", "own_log", "full"):
-        raise LaunchError(f"output='{value}' is not one of 'screen', 'log', 'both'")
-    return value

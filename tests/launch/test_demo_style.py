@@ -68,6 +68,7 @@ def test_a_robot_description_reaches_its_node_whole(rosl: Rosl, file_name: str) 
         "check_msgs_launch_test.py",
         "check_multiple_nodes_launch_test.py",
         "static_publisher_launch_test.py",
+        "set_param_launch_test.py",
     ],
 )
 def test_launch_tests_in_the_style_of_ros2_examples_pass(rosl: Rosl, file_name: str) -> None:

@@ -42,8 +42,8 @@ _SUBMODULES = frozenset(
 
 
 def __getattr__(name: str) -> Any:
-    if name == "Context":  # rclpy exports it at the top (launch_testing_examples use it)
-        return importlib.import_module("rclpy.context").Context
+    if name in ("Context", "Parameter"):  # rclpy has them at the top too (tests use them)
+        return getattr(importlib.import_module(f"rclpy.{name.lower()}"), name)
     if name in _SUBMODULES:
         return importlib.import_module(f"rclpy.{name}")
     raise AttributeError(f"module 'rclpy' has no attribute '{name}'")

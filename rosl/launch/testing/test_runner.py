@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from rosl.launch.testing.loader import TestRun
 
 DIED = "Processes under test stopped before tests completed"
+GRACE_SEC = 0.5  # once the active tests are done: a process ending just then ends by itself
 
 
 @dataclass(slots=True)
@@ -224,7 +225,7 @@ class LaunchTestRunner:
             self._active = self._unittest(self.test_run.pre_shutdown_tests)
         finally:
             self._completed.set()
-            self.supervisor.request_shutdown("the active tests have finished")
+            self.supervisor.request_shutdown("the active tests have finished", grace=GRACE_SEC)
 
     def _unittest(self, suite: unittest.TestSuite) -> unittest.TestResult:
         runner = unittest.TextTestRunner(
