@@ -274,6 +274,8 @@ TAGS: dict[str, Tag] = {
     "set_use_sim_time": _tag("value"),
     "reset": _tag("", "keep"),
     "ros_timer": _tag("period", children=True),
+    "for": _tag("len name", children=True),
+    "for_each": _tag("values", children=True),
 }
 _NESTED = {
     "choice": _tag("value"),
@@ -479,6 +481,30 @@ def _unset_env(entity: Entity) -> Any:
     return unset(_text(entity, "name", required=True), **_condition(entity))
 
 
+def build_for(entity: Entity) -> Any:
+    """``<for len= name=>``: its children once per index, ``$(index NAME)`` in them."""
+    from rosl.launch import loops
+
+    name = _plain(entity, "name", required=True) or ""
+    return loops.ForLoop(
+        _text(entity, "len", required=True),
+        function=lambda i: [loops.Iteration({name: i}, _child_actions(entity))],
+        name=name,
+        **_condition(entity),
+    )
+
+
+def build_for_each(entity: Entity) -> Any:
+    """``<for_each values=>``: its children once per value set, ``$(for-var NAME)`` in them."""
+    from rosl.launch import loops
+
+    return loops.ForEach(
+        _text(entity, "values", required=True),
+        function=loops.frontend_body(lambda: _child_actions(entity)),
+        **_condition(entity),
+    )
+
+
 BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "arg": build_arg,
     "let": lambda e: actions.SetLaunchConfiguration(
@@ -521,6 +547,8 @@ BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "reset": lambda e: actions.ResetLaunchConfigurations(
         dict(_name_values(e, "keep")) or None, **_condition(e)
     ),
+    "for": build_for,
+    "for_each": build_for_each,
     "ros_timer": lambda e: ros_actions.RosTimer(
         period=_text(e, "period", required=True), actions=_child_actions(e), **_condition(e)
     ),

@@ -166,6 +166,12 @@ def _command(arguments: list[Any], path: Path | None) -> subs.Substitution:
     return subs.Command(arguments[0], on_stderr=arguments[1])
 
 
+def _loops() -> Any:
+    from rosl.launch import loops
+
+    return loops
+
+
 _Factory = tuple[int, int, "Callable[[list[Any], Path | None], subs.Substitution]"]
 SUBSTITUTIONS: dict[str, _Factory] = {
     "var": (1, 2, lambda a, p: subs.LaunchConfiguration(a[0], default=a[1] if a[1:] else None)),
@@ -185,6 +191,12 @@ SUBSTITUTIONS: dict[str, _Factory] = {
     "not": (1, 1, lambda a, p: logic.NotSubstitution(a[0])),
     "and": (2, 2, lambda a, p: logic.AndSubstitution(a[0], a[1])),
     "or": (2, 2, lambda a, p: logic.OrSubstitution(a[0], a[1])),
+    "index": (1, 1, lambda a, p: _loops().ForLoopIndex(a[0])),
+    "for-var": (
+        1,
+        2,
+        lambda a, p: _loops().ForEachVar(a[0], default_value=a[1] if a[1:] else None),
+    ),
     "file-content": (1, 1, lambda a, p: subs.FileContent(a[0])),
     "launch-log-dir": (0, 0, lambda a, p: subs.LaunchLogDir()),
     "equals": (2, 2, lambda a, p: logic.EqualsSubstitution(a[0], a[1])),

@@ -18,12 +18,15 @@ from rosl.launch.actions import (
     UnsetEnvironmentVariable,
 )
 from rosl.launch.event_handlers import RegisterEventHandler
+from rosl.launch.loops import ForEach, ForLoop
 
 __all__ = [
     "AppendEnvironmentVariable",
     "DeclareLaunchArgument",
     "EmitEvent",
     "ExecuteProcess",
+    "ForEach",
+    "ForLoop",
     "GroupAction",
     "IncludeLaunchDescription",
     "LogInfo",

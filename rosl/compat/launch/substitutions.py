@@ -11,6 +11,7 @@ from rosl.launch.logic_substitutions import (
     NotSubstitution,
     OrSubstitution,
 )
+from rosl.launch.loops import ForEachVar, ForLoopIndex
 from rosl.launch.substitutions import (
     AnonName,
     Command,
@@ -39,6 +40,8 @@ __all__ = [
     "EqualsSubstitution",
     "FileContent",
     "FindExecutable",
+    "ForEachVar",
+    "ForLoopIndex",
     "IfElseSubstitution",
     "LaunchConfiguration",
     "LaunchLogDir",
