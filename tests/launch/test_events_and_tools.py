@@ -339,6 +339,8 @@ import launch_testing.tools
 import launch_testing_ros.tools
 import pytest
 from launch.actions import ExecuteProcess
+from launch_testing.tools.output import expect_output as expect_from_output
+from launch_testing.tools.text import build_line_match
 
 
 @pytest.mark.launch_test
@@ -363,6 +365,8 @@ class TestTools(unittest.TestCase):
         self.assertTrue(launch_testing.tools.expect_output(
             expected_lines=[f"hello {word}", f"count {count}"], text=command.output, strict=True
         ), command.output)
+        self.assertTrue(expect_from_output(command.output, expected_lines=[f"count {count}"]))
+        self.assertIsNotNone(build_line_match("count")(command.output.splitlines()))
 
     def test_wait_for_output_then_stop(self, launch_service, proc_info, proc_output):
         code = "import time\\nprint('ready', flush=True)\\ntime.sleep(60)"

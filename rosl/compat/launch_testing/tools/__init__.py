@@ -1,6 +1,5 @@
 """launch_testing.tools (rosl.launch.testing.tools and .process_proxy implement it)."""
 
-from rosl.launch.testing import tools as text
 from rosl.launch.testing.process_proxy import ProcessProxy, launch_process
 from rosl.launch.testing.tools import (
     basic_output_filter,
@@ -8,13 +7,10 @@ from rosl.launch.testing.tools import (
     expected_output_from_file,
 )
 
-output = text
 __all__ = [
     "ProcessProxy",
     "basic_output_filter",
     "expect_output",
     "expected_output_from_file",
     "launch_process",
-    "output",
-    "text",
 ]
