@@ -25,12 +25,22 @@ from rosl.cli.options import domain_option, export_domain
     default=None,
     help="Name of the package the test is in (names the test module)",
 )
+@click.option("-v", "--verbose", is_flag=True, help="Run with verbose output")
+@click.option(
+    "--junit-xml",
+    "junit_xml",
+    default=None,
+    metavar="PATH",
+    help="Write a JUnit XML report (as colcon reads) to PATH",
+)
 @domain_option
 def command(
     launch_test_file: str,
     launch_arguments: tuple[str, ...],
     show_args: bool,
     package_name: str | None,
+    verbose: bool,
+    junit_xml: str | None,
     domain_id: int | None,
 ) -> int:
     """Run a launch test: its launch, active tests, then post-shutdown tests (exit 0/1)."""
@@ -40,8 +50,9 @@ def command(
     export_domain(domain_id)
     arguments = parse_arguments(list(launch_arguments))
     code = launch_test.main(
-        Path(launch_test_file), arguments, show_args=show_args, package_name=package_name
-    )
+        Path(launch_test_file), arguments, show_args=show_args, package_name=package_name,
+        verbose=verbose, junit_xml=Path(junit_xml) if junit_xml else None,
+    )  # fmt: skip
     if code == 130:  # a Ctrl-C: CPython must not end the process by SIGINT after all (-2)
         from rosl.pkg import interrupts
 

@@ -92,6 +92,26 @@ class SetLaunchConfiguration(Action):
         context.launch_configurations[perform(context, self.name)] = perform(context, self.value)
 
 
+class ResetLaunchConfigurations(Action):
+    """Forget the launch configurations of this scope, but those given (name -> value)."""
+
+    def __init__(
+        self, launch_configurations: dict[SomeSubstitutions, SomeSubstitutions] | None = None,
+        **kwargs: Any,
+    ) -> None:  # fmt: skip
+        super().__init__(**kwargs)
+        self.launch_configurations = launch_configurations
+
+    def execute(self, context: LaunchContext) -> None:
+        """Clear the scope's configurations, then set the given ones."""
+        kept = {
+            perform(context, k): perform(context, v)
+            for k, v in (self.launch_configurations or {}).items()
+        }
+        context.launch_configurations.clear()
+        context.launch_configurations.update(kept)
+
+
 class SetEnvironmentVariable(Action):
     """Set an environment variable for processes started after it (in this scope)."""
 
@@ -270,6 +290,8 @@ XMLLaunchDescriptionSource = PythonLaunchDescriptionSource  # the file's suffix 
 class ExecuteProcess(Action):
     """Start a process (launch.actions.ExecuteProcess)."""
 
+    completes_later = True  # when the process has exited (OnExecutionComplete)
+
     def __init__(
         self,
         *,
@@ -282,6 +304,8 @@ class ExecuteProcess(Action):
         output: str = "log",
         respawn: bool | SomeSubstitutions = False,
         respawn_delay: float | None = None,
+        respawn_max_retries: int = -1,
+        cached_output: bool = False,
         emulate_tty: bool = False,
         sigterm_timeout: SomeSubstitutions = None,
         sigkill_timeout: SomeSubstitutions = None,
@@ -300,6 +324,8 @@ class ExecuteProcess(Action):
         self.output = output
         self.respawn = respawn
         self.respawn_delay = respawn_delay or 0.0
+        self.respawn_max_retries = int(respawn_max_retries)  # -1: no limit
+        del cached_output  # every line reaches the handlers as it comes
         self.emulate_tty = emulate_tty
         self.sigterm_timeout = sigterm_timeout
         self.sigkill_timeout = sigkill_timeout
@@ -352,7 +378,7 @@ class ExecuteProcess(Action):
 
     def execute(self, context: LaunchContext) -> None:
         """Hand the process to the supervisor."""
-        from rosl.launch.supervisor import ProcessSpec
+        from rosl.launch.records import ProcessSpec
 
         if self.shell:  # named after its command, not after the shell (substituted once)
             words = self.words(context)
@@ -368,6 +394,7 @@ class ExecuteProcess(Action):
             output=str(perform(context, self.output)),
             respawn=_flag(context, self.respawn),
             respawn_delay=float(self.respawn_delay),
+            respawn_max_retries=self.respawn_max_retries,
             emulate_tty=self.emulate_tty,
             sigterm_timeout=_seconds(context, self.sigterm_timeout, "sigterm_timeout"),
             sigkill_timeout=_seconds(context, self.sigkill_timeout, "sigkill_timeout"),
@@ -384,7 +411,7 @@ class ExecuteProcess(Action):
 def _flag(context: LaunchContext, value: Any) -> bool:
     if isinstance(value, bool):
         return value
-    return perform(context, value).strip().lower() in ("true", "1")
+    return perform(context, value).strip().lower() in ("true", "1", "yes", "on")
 
 
 def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
@@ -401,6 +428,8 @@ def _seconds(context: LaunchContext, value: Any, configuration: str) -> float:
 
 class TimerAction(Action):
     """Run actions after a delay."""
+
+    completes_later = True  # when its actions have run (OnExecutionComplete)
 
     def __init__(
         self, *, period: float | SomeSubstitutions, actions: list[Any], **kwargs: Any
@@ -422,8 +451,14 @@ class TimerAction(Action):
             seconds = -1.0
         if not seconds >= 0:  # (NaN too)
             raise LaunchError(f"a timer's period must be a number of seconds >= 0, not '{text}'")
-        if context.supervisor is not None:
-            context.supervisor.call_later(seconds, lambda: process(self.actions, context))
+        supervisor = context.supervisor
+        if supervisor is not None:
+
+            def fire() -> None:
+                process(self.actions, context)
+                supervisor.completed(self, context)
+
+            supervisor.call_later(seconds, fire)
 
     def children(self) -> list[Any]:
         """The delayed actions."""
@@ -469,22 +504,30 @@ class Shutdown(Action):
 
 
 class EmitEvent(Action):
-    """Emit an event; rosl understands ``Shutdown`` and launch_ros' lifecycle ``ChangeState``."""
+    """Emit an event: ``Shutdown``, ``ShutdownProcess``/``SignalProcess`` or ``ChangeState``."""
 
     def __init__(self, *, event: Any, **kwargs: Any) -> None:
+        from rosl.launch.events import ProcessTargetedEvent
         from rosl.launch.lifecycle_events import ChangeState
 
         super().__init__(**kwargs)
-        if not isinstance(event, (Shutdown, ChangeState)):
+        if not isinstance(event, (Shutdown, ProcessTargetedEvent, ChangeState)):
             raise LaunchError(
                 f"EmitEvent(event={type(event).__name__}(...)) is not supported by rosl: "
-                "the events it emits are launch.events.Shutdown and "
+                "the events it emits are launch.events.Shutdown, "
+                "launch.events.process.ShutdownProcess / SignalProcess and "
                 "launch_ros.events.lifecycle.ChangeState"
             )
         self.event = event
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
         """Act on the event."""
+        from rosl.launch.events import ProcessTargetedEvent, emit_to_processes
+
+        if isinstance(self.event, ProcessTargetedEvent):
+            if context.supervisor is not None:
+                emit_to_processes(self.event, context.supervisor)
+            return None
         return [self.event]
 
 

@@ -20,7 +20,7 @@ class Scope:
     namespace: str = ""
     environment: dict[str, str] = field(default_factory=dict)
     unset: set[str] = field(default_factory=set)  # removed from the environment (UnsetEnv...)
-    parameters: list[tuple[str, Any]] = field(default_factory=list)
+    parameters: list[Any] = field(default_factory=list)  # (name, value) or a ParameterFile
     remappings: list[tuple[str, str]] = field(default_factory=list)
 
 

@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import os
+import re
+import sys
+import sysconfig
+import traceback
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rosl.launch.errors import LaunchError
@@ -9,9 +15,57 @@ from rosl.launch.substitutions import SomeSubstitutions, perform
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
-    from pathlib import Path
 
     from rosl.launch.context import LaunchContext
+
+_ROSL_DIR = str(Path(__file__).resolve().parents[1]) + os.sep
+_LOCATED = re.compile(r"^\S+:\d+: ")
+
+
+def creation_site() -> str | None:
+    """``file:line`` of the innermost caller outside rosl (where a launch file made an action)."""
+    frame = sys._getframe(1)
+    while frame is not None:
+        name = frame.f_code.co_filename
+        if not name.startswith((_ROSL_DIR, "<")):
+            return f"{name}:{frame.f_lineno}"
+        frame = frame.f_back  # type: ignore[assignment]
+    return None
+
+
+_LIBRARIES = tuple(
+    {sysconfig.get_paths()[k] + os.sep for k in ("stdlib", "platstdlib", "purelib", "platlib")}
+)
+
+
+def user_error(err: BaseException) -> LaunchError | None:
+    """``file:line: Type: message`` when ``err`` was raised by a launch file's own code.
+
+    The innermost frame outside Python's and the installed libraries decides: a launch file's
+    (the user's mistake: one line), or rosl's (a bug: None, so its traceback is kept).
+    """
+    for frame in reversed(traceback.extract_tb(err.__traceback__)):
+        name = frame.filename
+        if name.startswith(_LIBRARIES) and not name.startswith(_ROSL_DIR):
+            continue
+        if name.startswith((_ROSL_DIR, "<")):
+            return None
+        return LaunchError(f"{name}:{frame.lineno}: {type(err).__name__}: {err}")
+    return None
+
+
+def located(error: LaunchError, location: str | None, context: LaunchContext) -> LaunchError:
+    """The error with ``file:line:`` of the action it came from, unless it names a line already.
+
+    A ``file: `` prefix naming the file being processed gives way to the line (the file once).
+    """
+    text = str(error)
+    if location is None or _LOCATED.match(text):
+        return error
+    for file in (context.current_file, location.rsplit(":", 1)[0]):
+        if file is not None:
+            text = text.removeprefix(f"{file}: ")
+    return LaunchError(f"{location}: {text}")
 
 
 class Condition:
@@ -62,6 +116,7 @@ class Action:
                 f"{type(self).__name__}() got unsupported argument(s): {', '.join(sorted(unknown))}"
             )
         self.condition = condition
+        self.location = creation_site()  # file:line, named by errors raised when it runs
 
     def visit(self, context: LaunchContext) -> list[Any] | None:
         """Run the action if its condition holds; return further entities to process."""
@@ -152,14 +207,19 @@ def check_required_arguments(
         walk(entity, False, frozenset())
     for argument in required:
         if argument.name not in context.launch_configurations:
+            where = getattr(argument, "location", None) or path  # its own line, in its file
             raise LaunchError(
-                f"{path}: launch argument '{argument.name}' is required "
+                f"{where}: launch argument '{argument.name}' is required "
                 f"({argument.description}); pass it as {argument.name}:=<value>"
             )
 
 
 def process(entities: Iterable[Any], context: LaunchContext) -> None:
-    """Visit entities in order; what an entity returns is processed right after it."""
+    """Visit entities in order; what an entity returns is processed right after it.
+
+    An action that does its work at once (not a process, not a timer) is complete then, and
+    OnExecutionComplete handlers hear of it.
+    """
     for entity in entities:
         if entity is None:
             continue
@@ -168,6 +228,43 @@ def process(entities: Iterable[Any], context: LaunchContext) -> None:
                 f"{context.current_file or 'launch description'}: '{entity!r}' is not a launch "
                 "action (expected launch actions such as Node(...) in the list)"
             )
-        more = entity.visit(context)
+        try:
+            more = entity.visit(context)
+        except LaunchError as err:
+            raise located(err, getattr(entity, "location", None), context) from None
+        except Exception as err:  # the user's own code (an OpaqueFunction's): one line
+            found = user_error(err)
+            if found is None:
+                raise  # rosl's own bug: keep its traceback
+            raise found from None
         if more:
             process(more, context)
+        if context.supervisor is not None and not getattr(entity, "completes_later", False):
+            context.supervisor.completed(entity, context)
+
+
+def process_for_event(handler: Any, event: Any, context: LaunchContext) -> None:
+    """Run an event handler: what it returns for ``event``, with ``event`` among the locals.
+
+    As launch does: ``LocalSubstitution('event.returncode')`` in its actions reads the event.
+    An exception raised by the user's handler function is one line naming its file and line.
+    """
+    try:
+        entities = handler.entities(event, context)
+    except LaunchError:
+        raise
+    except Exception as err:
+        found = user_error(err)
+        if found is None:
+            raise
+        raise found from None
+    had = "event" in context.locals
+    previous = context.locals.get("event")
+    context.locals["event"] = event
+    try:
+        process(entities, context)
+    finally:
+        if had:
+            context.locals["event"] = previous
+        else:
+            context.locals.pop("event", None)

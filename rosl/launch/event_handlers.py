@@ -1,4 +1,4 @@
-"""Event handlers (launch.event_handlers): OnProcessStart, OnProcessExit, OnProcessIO.
+"""Event handlers (launch.event_handlers): OnProcessStart/Exit/IO, OnExecutionComplete.
 
 A handler names the process it watches (``target_action``: the action, a predicate taking
 the action, or None for every process) and what to run: an action, a list of them, or a
@@ -12,12 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from rosl.launch.description import Action, process
+from rosl.launch.description import Action, process_for_event
 from rosl.launch.errors import LaunchError
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
-    from rosl.launch.supervisor import ProcessEvent
+    from rosl.launch.records import ProcessEvent
 
 
 @dataclass(frozen=True, slots=True)
@@ -129,6 +129,23 @@ class OnShutdown(EventHandler):
         super().__init__(handler=on_shutdown, handle_once=handle_once)
 
 
+class OnExecutionComplete(EventHandler):
+    """React when an action has done its work: ``on_completion(event, context)`` or actions.
+
+    A process's action is done when it exited for good, a timer's when it fired, any other
+    action's when it ran; the event has ``action``.
+    """
+
+    kinds = ("complete",)
+
+    def __init__(
+        self, *, target_action: Any = None, on_completion: Any = None, handle_once: bool = False
+    ) -> None:
+        super().__init__(
+            target_action=target_action, handler=on_completion, handle_once=handle_once
+        )
+
+
 class OnProcessIO(EventHandler):
     """React to each line a process prints: ``on_stdout(event)`` / ``on_stderr(event)``."""
 
@@ -169,8 +186,8 @@ class RegisterEventHandler(Action):
         if not isinstance(event_handler, EventHandler):
             raise LaunchError(
                 f"RegisterEventHandler({type(event_handler).__name__}(...)) is not supported by "
-                "rosl: its event handlers are OnProcessStart, OnProcessExit, OnProcessIO and "
-                "OnShutdown"
+                "rosl: its event handlers are OnProcessStart, OnProcessExit, OnProcessIO, "
+                "OnExecutionComplete and OnShutdown"
             )
         self.event_handler = event_handler
 
@@ -186,6 +203,6 @@ class RegisterEventHandler(Action):
 
         def watch(event: ProcessEvent) -> None:
             if handler.matches(event):
-                process(handler.entities(event, context), context)
+                process_for_event(handler, event, context)
 
         supervisor.watchers.append(watch)

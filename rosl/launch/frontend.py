@@ -129,17 +129,42 @@ def _plain(entity: Entity, name: str, *, required: bool = False) -> str | None:
     return re.sub(r"\\(.)", r"\1", _scalar(entity, name, value))
 
 
+# launch types a boolean attribute by YAML rules: YAML 1.1's words, as PyYAML reads them
+TRUE_WORDS = ("true", "yes", "on")
+FALSE_WORDS = ("false", "no", "off")
+
+
 def _flag(entity: Entity, name: str, *, substitutions: bool = False) -> Any:
-    """A true/false attribute (with ``substitutions``, a ``$(...)`` resolved at run time)."""
+    """A boolean attribute (with ``substitutions``, a ``$(...)`` resolved at run time).
+
+    ``true``/``false`` and YAML's ``yes``/``no``/``on``/``off``, as launch's frontend reads them.
+    """
     value = entity.value(name)
     if value is None or isinstance(value, bool):
         return value
     text = _scalar(entity, name, value)
-    if text.strip().lower() in ("true", "false"):
-        return text.strip().lower() == "true"
+    word = text.strip().lower()
+    if word in TRUE_WORDS or word in FALSE_WORDS:
+        return word in TRUE_WORDS
     if substitutions and "$(" in text:
         return _substituted(entity, text)
-    raise entity.fail(f"attribute '{name}' of {entity.label} must be true or false, not '{text}'")
+    raise entity.fail(
+        f"attribute '{name}' of {entity.label} must be a boolean (true/false, yes/no, on/off), "
+        f"not '{text}'"
+    )
+
+
+def _on_exit(entity: Entity) -> Any:
+    """``on_exit="shutdown"``: the launch ends when the process does (the only word launch has)."""
+    value = entity.value("on_exit")
+    if value is None:
+        return None
+    text = _scalar(entity, "on_exit", value).strip()
+    if text != "shutdown":
+        raise entity.fail(
+            f"attribute 'on_exit' of {entity.label} can only be 'shutdown', not '{text}'"
+        )
+    return [actions.Shutdown(reason=f"{entity.kind} exited (on_exit=shutdown)")]
 
 
 def _number(entity: Entity, name: str) -> float | None:
@@ -156,6 +181,13 @@ def _number(entity: Entity, name: str) -> float | None:
     if number < 0:
         raise entity.fail(f"attribute '{name}' of {entity.label} must not be negative")
     return number
+
+
+def _count(entity: Entity, name: str) -> int | None:
+    number = _number(entity, name)
+    if number is not None and number != int(number):
+        raise entity.fail(f"attribute '{name}' of {entity.label} must be a whole number")
+    return None if number is None else int(number)
 
 
 def _key(value: Any) -> Any:
@@ -218,8 +250,8 @@ def command_words(entity: Entity, name: str) -> list[Any] | None:
 _NAME_VALUE = _tag("name value")
 _PARAM = _tag("name value type from allow_substs", "param")
 _PROCESS = (
-    "cwd name launch-prefix output respawn respawn_delay shell emulate_tty sigterm_timeout "
-    "sigkill_timeout"
+    "cwd name launch-prefix output respawn respawn_delay respawn_max_retries shell emulate_tty "
+    "sigterm_timeout sigkill_timeout on_exit"
 )
 TAGS: dict[str, Tag] = {
     "arg": _tag("name default description", "choice"),
@@ -241,6 +273,12 @@ TAGS: dict[str, Tag] = {
     ),
     "set_parameter": _tag("name value"),
     "set_remap": _tag("from to"),
+    "set_parameters_from_file": _tag("filename"),
+    "set_use_sim_time": _tag("value"),
+    "reset": _tag("", "keep"),
+    "ros_timer": _tag("period", children=True),
+    "for": _tag("len name", children=True),
+    "for_each": _tag("values", children=True),
 }
 _NESTED = {
     "choice": _tag("value"),
@@ -323,11 +361,13 @@ def _process(entity: Entity) -> dict[str, Any]:
         "output": _text(entity, "output"),
         "respawn": _flag(entity, "respawn", substitutions=True),
         "respawn_delay": _number(entity, "respawn_delay"),
+        "respawn_max_retries": _count(entity, "respawn_max_retries"),
         "shell": _flag(entity, "shell"),
         "emulate_tty": _flag(entity, "emulate_tty"),
         "sigterm_timeout": _text(entity, "sigterm_timeout"),
         "sigkill_timeout": _text(entity, "sigkill_timeout"),
         "additional_env": dict(_name_values(entity, "env")) or None,
+        "on_exit": _on_exit(entity),
     }
     return {k: v for k, v in options.items() if v is not None} | _condition(entity)
 
@@ -379,9 +419,9 @@ def parameters(entity: Entity) -> list[Any]:
         if param.value("from") is not None:
             if param.value("name") is not None or param.nested("param"):
                 raise param.fail(f"{param.label} with 'from' has no 'name' and no nested params")
-            if _flag(param, "allow_substs"):
-                raise param.fail("rosl does not expand substitutions inside parameter files")
-            found.append(_text(param, "from"))
+            allow = _flag(param, "allow_substs", substitutions=True)
+            source = _text(param, "from")
+            found.append(ros_actions.ParameterFile(source, allow_substs=allow) if allow else source)
             continue
         if not found or not isinstance(found[-1], dict):
             found.append({})
@@ -458,6 +498,30 @@ def _unset_env(entity: Entity) -> Any:
     return unset(_text(entity, "name", required=True), **_condition(entity))
 
 
+def build_for(entity: Entity) -> Any:
+    """``<for len= name=>``: its children once per index, ``$(index NAME)`` in them."""
+    from rosl.launch import loops
+
+    name = _plain(entity, "name", required=True) or ""
+    return loops.ForLoop(
+        _text(entity, "len", required=True),
+        function=lambda i: [loops.Iteration({name: i}, _child_actions(entity))],
+        name=name,
+        **_condition(entity),
+    )
+
+
+def build_for_each(entity: Entity) -> Any:
+    """``<for_each values=>``: its children once per value set, ``$(for-var NAME)`` in them."""
+    from rosl.launch import loops
+
+    return loops.ForEach(
+        _text(entity, "values", required=True),
+        function=loops.frontend_body(lambda: _child_actions(entity)),
+        **_condition(entity),
+    )
+
+
 BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "arg": build_arg,
     "let": lambda e: actions.SetLaunchConfiguration(
@@ -491,6 +555,21 @@ BUILDERS: dict[str, Callable[[Entity], Any]] = {
     "set_remap": lambda e: ros_actions.SetRemap(
         _text(e, "from", required=True), _text(e, "to", required=True), **_condition(e)
     ),
+    "set_parameters_from_file": lambda e: ros_actions.SetParametersFromFile(
+        _text(e, "filename", required=True), **_condition(e)
+    ),
+    "set_use_sim_time": lambda e: ros_actions.SetUseSimTime(
+        _flag(e, "value", substitutions=True) if e.value("value") is not None else True,
+        **_condition(e),
+    ),
+    "reset": lambda e: actions.ResetLaunchConfigurations(
+        dict(_name_values(e, "keep")) or None, **_condition(e)
+    ),
+    "for": build_for,
+    "for_each": build_for_each,
+    "ros_timer": lambda e: ros_actions.RosTimer(
+        period=_text(e, "period", required=True), actions=_child_actions(e), **_condition(e)
+    ),
 }
 BUILDERS["push_ros_namespace"] = BUILDERS["push-ros-namespace"]
 
@@ -499,7 +578,6 @@ _REFUSED = {
     "node_container": _COMPONENTS,
     "load_composable_node": _COMPONENTS,
 }
-_LOCATED = re.compile(r"^\S+:\d+: ")
 
 
 def build_action(entity: Entity) -> Any:
@@ -519,20 +597,7 @@ def build_action(entity: Entity) -> Any:
         )
     entity.check(TAGS[entity.kind], guarded=True)
     action = BUILDERS[entity.kind](entity)
-    visit = action.visit
-    where = f"{entity.path}:{entity.line}"
-
-    def located_visit(context: Any) -> Any:
-        try:
-            return visit(context)
-        except LaunchError as err:
-            text = str(err)
-            if _LOCATED.match(text):
-                raise
-            text = text.removeprefix(f"{entity.path}: ")
-            raise LaunchError(f"{where}: {text}") from None
-
-    action.visit = located_visit
+    action.location = f"{entity.path}:{entity.line}"  # errors it raises when it runs name it
     return action
 
 

@@ -24,7 +24,8 @@ from rosl.launch.substitutions import perform
 
 if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
-    from rosl.launch.supervisor import ProcessEvent, ShutdownEvent, Supervisor
+    from rosl.launch.records import ProcessEvent, ShutdownEvent
+    from rosl.launch.supervisor import Supervisor
     from rosl.node.node import Node as RosNode
 
 _LOGGER = "launch_ros.actions.lifecycle_node"

@@ -29,11 +29,6 @@ _TRANSITION_WORDS = (
 )  # fmt: skip
 
 
-def matches_action(target_action: Any) -> Callable[[Any], bool]:
-    """A matcher accepting ``target_action`` itself (launch.events.matches_action)."""
-    return lambda action: action is target_action
-
-
 def matches_node_name(node_name: str) -> Callable[[Any], bool]:
     """A matcher accepting the lifecycle node of that full name (``/ns/name``)."""
     return lambda action: getattr(action, "lifecycle_node_name", None) == node_name

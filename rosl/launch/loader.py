@@ -90,6 +90,15 @@ def _line_in(path: Path, err: BaseException) -> int:
     return frames[-1].lineno or 0 if frames else 0
 
 
+def description_from_file(launch_file_path: str | Path) -> LaunchDescription:
+    """The LaunchDescription of a launch file of any format (launch_description_sources').
+
+    Raises:
+        LaunchError: the file is missing or broken (one line naming it).
+    """
+    return load_description(Path(launch_file_path))
+
+
 def find_in_package(package: str, file_name: str) -> Path:
     """Find ``file_name`` anywhere in a package's folder, as ros2 launch does.
 

@@ -14,7 +14,7 @@ import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rosl.launch.actions import ExecuteProcess
+from rosl.launch.actions import ExecuteProcess, TimerAction
 from rosl.launch.description import Action
 from rosl.launch.errors import LaunchError
 from rosl.launch.substitutions import (
@@ -42,15 +42,40 @@ class ParameterValue:
 
 
 class ParameterFile:
-    """A parameter file given to a Node (launch_ros.descriptions.ParameterFile)."""
+    """A parameter file given to a Node (launch_ros.descriptions.ParameterFile).
 
-    def __init__(self, param_file: SomeSubstitutions, *, allow_substs: bool = False) -> None:
-        if allow_substs:
-            raise LaunchError(
-                "ParameterFile(allow_substs=True) is not supported by rosl: substitutions "
-                "inside a parameter file are not expanded; pass the values as a dict instead"
-            )
+    With ``allow_substs`` the file's ``$(...)`` substitutions (``$(var x)``, ``$(env X)``, ...)
+    are performed first, and the node gets the substituted copy.
+    """
+
+    def __init__(
+        self, param_file: SomeSubstitutions, *, allow_substs: bool | SomeSubstitutions = False
+    ) -> None:
         self.param_file = param_file
+        self.allow_substs = allow_substs
+
+    def substituted(self, context: LaunchContext, path: Path, label: str) -> Path:
+        """The file to hand to the node: ``path``, or its substituted copy.
+
+        Raises:
+            LaunchError: a substitution in the file cannot be read or performed.
+        """
+        allow = self.allow_substs
+        if not isinstance(allow, bool):
+            allow = perform(context, allow).strip().lower() in ("true", "1", "yes", "on")
+        if not allow:
+            return path
+        from rosl.launch.substitution_text import SubstitutionSyntaxError, parse_substitution
+
+        try:
+            text = perform(context, parse_substitution(path.read_text(encoding="utf-8"), path=path))
+        except SubstitutionSyntaxError as err:
+            raise LaunchError(f"{path}: bad substitution: {err}") from None
+        except (OSError, UnicodeDecodeError) as err:
+            raise LaunchError(f"{path}: cannot read: {err}") from None
+        if context.supervisor is None:
+            return path
+        return context.supervisor.parameter_files.write_text(label, text)
 
 
 def yaml_typed(text: str) -> Any:
@@ -110,13 +135,17 @@ def parameter_value(context: LaunchContext, value: Any) -> Any:
     return resolve_value(context, value)
 
 
+_FOXY_NAMES = {"node_executable": "executable", "node_name": "name",
+               "node_namespace": "namespace"}  # fmt: skip
+
+
 class Node(ExecuteProcess):
     """Start a package's executable as a ROS node (launch_ros.actions.Node)."""
 
     def __init__(
         self,
         *,
-        executable: SomeSubstitutions,
+        executable: SomeSubstitutions = None,
         package: SomeSubstitutions = None,
         name: SomeSubstitutions = None,
         namespace: SomeSubstitutions = None,
@@ -127,6 +156,14 @@ class Node(ExecuteProcess):
         arguments: list[SomeSubstitutions] | None = None,
         **kwargs: Any,
     ) -> None:
+        old = sorted(k for k in kwargs if k in _FOXY_NAMES)
+        if old:
+            spelled = ", ".join(f"{k}= is now {_FOXY_NAMES[k]}=" for k in old)
+            raise LaunchError(
+                f"Node(): {spelled} (ROS 2 Dashing/Foxy's spelling, gone since Galactic)"
+            )
+        if executable is None:
+            raise LaunchError("Node() needs executable= (and package=)")
         super().__init__(cmd=[], **kwargs)
         self.package = package
         self.executable = executable
@@ -156,9 +193,7 @@ class Node(ExecuteProcess):
         values: dict[str, Any] = {}  # every inline value (what --print and the details show)
         steps: list[dict[str, Any] | str] = []  # inline groups and user files, in order
         group: dict[str, Any] = {}
-        for name, value in context.scope.parameters:
-            group[perform(context, name)] = parameter_value(context, value)
-        for entry in self.parameters:
+        for entry in [*_scoped_parameters(context), *self.parameters]:
             if isinstance(entry, dict):
                 for key, value in entry.items():
                     group[perform(context, key)] = parameter_value(context, value)
@@ -168,6 +203,8 @@ class Node(ExecuteProcess):
                     raise LaunchError(
                         f"parameter file {path} (for {self._label(context)}) does not exist"
                     )
+                if isinstance(entry, ParameterFile):
+                    path = entry.substituted(context, path, self._label(context))
                 if group:
                     steps.append(group)
                     group = {}
@@ -193,7 +230,7 @@ class Node(ExecuteProcess):
         elif supervisor is not None:
             for step in steps:
                 if isinstance(step, dict):
-                    step = str(supervisor.parameter_file(self._label(context), step))
+                    step = str(supervisor.parameter_files.write(self._label(context), step))
                 args += ["--params-file", step]
         return args, values
 
@@ -256,9 +293,7 @@ class Node(ExecuteProcess):
         self, context: LaunchContext
     ) -> tuple[list[str], dict[str, Any]]:
         values: dict[str, Any] = {}
-        for name, value in context.scope.parameters:
-            values[perform(context, name)] = parameter_value(context, value)
-        for entry in self.parameters:
+        for entry in [*_scoped_parameters(context), *self.parameters]:
             if isinstance(entry, dict):
                 values.update(
                     {perform(context, k): parameter_value(context, v) for k, v in entry.items()}
@@ -266,6 +301,14 @@ class Node(ExecuteProcess):
             else:
                 values[f"(file) {_parameter_file(context, entry)}"] = "..."
         return [], values
+
+
+def _scoped_parameters(context: LaunchContext) -> list[Any]:
+    """SetParameter's values (as one-entry dicts) and SetParametersFromFile's files, in order."""
+    return [
+        entry if isinstance(entry, ParameterFile) else {entry[0]: entry[1]}
+        for entry in context.scope.parameters
+    ]
 
 
 def _parameter_file(context: LaunchContext, entry: Any) -> Path:
@@ -297,6 +340,29 @@ class SetParameter(Action):
     def execute(self, context: LaunchContext) -> None:
         """Record it on the current scope."""
         context.scope.parameters.append((self.name, self.value))
+
+
+class SetParametersFromFile(Action):
+    """Give a parameter file to every node started after it (in this scope), before its own."""
+
+    def __init__(self, filename: SomeSubstitutions, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.filename = filename
+
+    def execute(self, context: LaunchContext) -> None:
+        """Record it on the current scope."""
+        context.scope.parameters.append(ParameterFile(perform(context, self.filename)))
+
+
+class SetUseSimTime(SetParameter):
+    """``use_sim_time`` for every node started after it (in this scope)."""
+
+    def __init__(self, value: Any, **kwargs: Any) -> None:
+        super().__init__("use_sim_time", value, **kwargs)
+
+
+class RosTimer(TimerAction):
+    """Run actions after a period (launch_ros.actions.RosTimer; rosl times it by the wall clock)."""
 
 
 class SetRemap(Action):

@@ -123,7 +123,7 @@ def start_recorder(supervisor: Supervisor, folder: Path) -> None:
     import sys
 
     from rosl.launch.errors import LaunchError
-    from rosl.launch.supervisor import ProcessSpec
+    from rosl.launch.records import ProcessSpec
 
     cmd = [sys.executable, "-P", "-m", "rosl", "bag", "record", "-a", "--include-services",
            "-o", str(folder)]  # fmt: skip

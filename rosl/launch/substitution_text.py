@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING, Any
 
+from rosl.launch import logic_substitutions as logic
 from rosl.launch import substitutions as subs
 
 if TYPE_CHECKING:
@@ -165,6 +166,12 @@ def _command(arguments: list[Any], path: Path | None) -> subs.Substitution:
     return subs.Command(arguments[0], on_stderr=arguments[1])
 
 
+def _loops() -> Any:
+    from rosl.launch import loops
+
+    return loops
+
+
 _Factory = tuple[int, int, "Callable[[list[Any], Path | None], subs.Substitution]"]
 SUBSTITUTIONS: dict[str, _Factory] = {
     "var": (1, 2, lambda a, p: subs.LaunchConfiguration(a[0], default=a[1] if a[1:] else None)),
@@ -181,9 +188,22 @@ SUBSTITUTIONS: dict[str, _Factory] = {
     "anon": (1, 1, lambda a, p: subs.AnonName(a[0])),
     "dirname": (0, 0, lambda a, p: subs.ThisLaunchFileDir(path=p)),
     "filename": (0, 0, lambda a, p: subs.ThisLaunchFile(path=p)),
-    "not": (1, 1, lambda a, p: subs.NotSubstitution(a[0])),
-    "and": (2, 2, lambda a, p: subs.AndSubstitution(a[0], a[1])),
-    "or": (2, 2, lambda a, p: subs.OrSubstitution(a[0], a[1])),
+    "not": (1, 1, lambda a, p: logic.NotSubstitution(a[0])),
+    "and": (2, 2, lambda a, p: logic.AndSubstitution(a[0], a[1])),
+    "or": (2, 2, lambda a, p: logic.OrSubstitution(a[0], a[1])),
+    "index": (1, 1, lambda a, p: _loops().ForLoopIndex(a[0])),
+    "for-var": (
+        1,
+        2,
+        lambda a, p: _loops().ForEachVar(a[0], default_value=a[1] if a[1:] else None),
+    ),
+    "file-content": (1, 1, lambda a, p: subs.FileContent(a[0])),
+    "launch-log-dir": (0, 0, lambda a, p: subs.LaunchLogDir()),
+    "equals": (2, 2, lambda a, p: logic.EqualsSubstitution(a[0], a[1])),
+    "not-equals": (2, 2, lambda a, p: logic.NotEqualsSubstitution(a[0], a[1])),
+    "if": (2, 3, lambda a, p: logic.IfElseSubstitution(*a)),
+    "all": (1, 1 << 10, lambda a, p: logic.AllSubstitution(*a)),
+    "any": (1, 1 << 10, lambda a, p: logic.AnySubstitution(*a)),
 }
 
 
@@ -203,7 +223,7 @@ def instantiate(name: str, arguments: list[Any], path: Path | None) -> subs.Subs
     least, most, factory = SUBSTITUTIONS[name]
     if not least <= len(arguments) <= most:
         wanted = str(least) if least == most else f"{least} to {most}"
-        if most > 2:
+        if most >= 1 << 10:
             wanted = f"at least {least}"
         raise SubstitutionSyntaxError(f"$({name}) takes {wanted} argument(s), not {len(arguments)}")
     return factory(arguments, path)

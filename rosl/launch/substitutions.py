@@ -103,11 +103,18 @@ class EnvironmentVariable(Substitution):
         return f"EnvVar({describe(self.name)})"
 
 
+class SubstitutionFailure(LaunchError):  # noqa: N818 - launch's name
+    """A substitution that cannot be performed (launch.substitutions.SubstitutionFailure)."""
+
+
 class PathJoinSubstitution(Substitution):
-    """Join path parts (each may be a substitution)."""
+    """Join path parts (each may be a substitution); ``/`` joins one more (launch since Jazzy)."""
 
     def __init__(self, substitutions: list[SomeSubstitutions]) -> None:
         self.substitutions = list(substitutions)
+
+    def __truediv__(self, other: SomeSubstitutions) -> PathJoinSubstitution:
+        return PathJoinSubstitution([*self.substitutions, other])
 
     def perform(self, context: LaunchContext) -> str:
         """The joined path."""
@@ -116,6 +123,49 @@ class PathJoinSubstitution(Substitution):
     def describe(self) -> str:
         """The parts joined with '/'."""
         return " + '/' + ".join(describe(part) for part in self.substitutions)
+
+
+class PathSubstitution(PathJoinSubstitution):
+    """A path to build on with ``/``: ``PathSubstitution(FindPackageShare('p')) / 'config'``."""
+
+    def __init__(self, path: SomeSubstitutions) -> None:
+        super().__init__([path])
+
+
+class FileContent(Substitution):
+    """The text of a file (``$(file-content PATH)``, launch since Jazzy)."""
+
+    def __init__(self, path: SomeSubstitutions) -> None:
+        self.path = path
+
+    def perform(self, context: LaunchContext) -> str:
+        """The file's text."""
+        path = perform(context, self.path)
+        try:
+            with open(path, encoding="utf-8") as file:
+                return file.read()
+        except (OSError, UnicodeDecodeError) as err:
+            why = err.strerror if isinstance(err, OSError) else "not UTF-8 text"
+            raise SubstitutionFailure(f"cannot read file {path}: {why}") from None
+
+    def describe(self) -> str:
+        """``FileContent(path)``."""
+        return f"FileContent({describe(self.path)})"
+
+
+class LaunchLogDir(Substitution):
+    """The launch's log folder (``$(launch-log-dir)``)."""
+
+    def perform(self, context: LaunchContext) -> str:
+        """The folder the launcher logs to."""
+        supervisor = context.supervisor
+        if supervisor is None:
+            raise SubstitutionFailure("LaunchLogDir used outside of a running launch")
+        return str(supervisor.log_dir)
+
+    def describe(self) -> str:
+        """``LaunchLogDir()``."""
+        return "LaunchLogDir()"
 
 
 class FindPackage(Substitution):
@@ -196,8 +246,24 @@ class ExecutableInPackage(FindPackage):
         return f"ExecInPkg(pkg={describe(self.package)}, exec={describe(self.executable)})"
 
 
+def rosl_executable(path: str | None = None) -> str | None:
+    """The ``rosl`` command (on the PATH, or beside this Python), which takes ``ros2``'s words."""
+    import shutil
+    import sys
+    from pathlib import Path
+
+    beside = Path(sys.executable).with_name("rosl")
+    if beside.is_file() and os.access(beside, os.X_OK):
+        return str(beside)
+    return shutil.which("rosl", path=path)
+
+
 class FindExecutable(Substitution):
-    """The path of an executable found on the PATH (``$(find-exec NAME)``)."""
+    """The path of an executable found on the PATH (``$(find-exec NAME)``).
+
+    Where no ``ros2`` is installed, ``FindExecutable(name='ros2')`` is rosl's own command, so a
+    launch file's ``ros2 ...`` commands run rosl's same words.
+    """
 
     def __init__(self, *, name: SomeSubstitutions) -> None:
         self.name = name
@@ -209,6 +275,8 @@ class FindExecutable(Substitution):
         name = perform(context, self.name)
         path = context.scope.environment.get("PATH", os.environ.get("PATH"))
         found = shutil.which(name, path=path)
+        if found is None and name == "ros2":  # no ROS 2 here: rosl says the same words
+            found = rosl_executable(path)
         if found is None:
             raise LaunchError(f"executable '{name}' not found on the PATH")
         return found
@@ -387,62 +455,40 @@ class Command(Substitution):
         return f"Command({describe(self.command)})"
 
 
-def _boolean(context: LaunchContext, value: SomeSubstitutions, what: str) -> bool:
-    text = perform(context, value).strip().lower()
-    if text in ("true", "1"):
-        return True
-    if text in ("false", "0"):
-        return False
-    raise LaunchError(f"{what}: '{text}' is not a boolean (true/false or 1/0)")
+class LocalSubstitution(Substitution):
+    """A value from the context's locals, as an event handler's actions see them.
 
+    ``LocalSubstitution('event.returncode')`` in the actions of an OnProcessExit handler is the
+    exit code of the process that ended (``event.action``, ``event.pid``, ...).
+    """
 
-class NotSubstitution(Substitution):
-    """``'true'`` when the value is false (``$(not V)``)."""
-
-    def __init__(self, value: SomeSubstitutions) -> None:
-        self.value = value
+    def __init__(self, expression: str, description: str | None = None) -> None:
+        self.expression = expression
+        self.description = description
 
     def perform(self, context: LaunchContext) -> str:
-        """``'true'`` or ``'false'``."""
-        return str(not _boolean(context, self.value, "not")).lower()
+        """The expression's value, read from the locals."""
+        head, _, rest = self.expression.partition(".")
+        if head not in context.locals:
+            known = ", ".join(sorted(k for k in context.locals if k != "anon")) or "none"
+            raise LaunchError(
+                f"LocalSubstitution('{self.expression}'): no local '{head}' here (locals: "
+                f"{known}; 'event' exists only in the actions of an event handler)"
+            )
+        value = context.locals[head]
+        for name in rest.split(".") if rest else []:
+            try:
+                value = value[name] if isinstance(value, dict) else getattr(value, name)
+            except (AttributeError, KeyError):
+                raise LaunchError(
+                    f"LocalSubstitution('{self.expression}'): {type(value).__name__} has no "
+                    f"'{name}'"
+                ) from None
+        return str(value)
 
     def describe(self) -> str:
-        """``NotSubstitution(...)``."""
-        return f"NotSubstitution({describe(self.value)})"
-
-
-class AndSubstitution(Substitution):
-    """``'true'`` when both values are true (``$(and L R)``)."""
-
-    word = "and"
-
-    def __init__(self, left: SomeSubstitutions, right: SomeSubstitutions) -> None:
-        self.left = left
-        self.right = right
-
-    def combine(self, left: bool, right: bool) -> bool:
-        """The logical operation."""
-        return left and right
-
-    def perform(self, context: LaunchContext) -> str:
-        """``'true'`` or ``'false'``."""
-        left = _boolean(context, self.left, self.word)
-        right = _boolean(context, self.right, self.word)
-        return str(self.combine(left, right)).lower()
-
-    def describe(self) -> str:
-        """``AndSubstitution(left right)``."""
-        return f"{type(self).__name__}({describe(self.left)} {describe(self.right)})"
-
-
-class OrSubstitution(AndSubstitution):
-    """``'true'`` when either value is true (``$(or L R)``)."""
-
-    word = "or"
-
-    def combine(self, left: bool, right: bool) -> bool:
-        """The logical operation."""
-        return left or right
+        """``LocalVar('expression')``."""
+        return self.description or f"LocalVar('{self.expression}')"
 
 
 def perform(context: LaunchContext, value: SomeSubstitutions) -> str:
@@ -454,6 +500,17 @@ def perform(context: LaunchContext, value: SomeSubstitutions) -> str:
     if isinstance(value, (list, tuple)):
         return "".join(perform(context, part) for part in value)
     return str(value)
+
+
+def normalize(value: SomeSubstitutions) -> list[Substitution]:
+    """A value as a list of substitutions, text as TextSubstitution (launch.utilities')."""
+    if value is None:
+        return []
+    if isinstance(value, Substitution):
+        return [value]
+    if isinstance(value, (list, tuple)):
+        return [part for item in value for part in normalize(item)]
+    return [TextSubstitution(text=str(value))]
 
 
 def describe(value: SomeSubstitutions) -> str:

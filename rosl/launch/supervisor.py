@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, cast
 
-from rosl.launch.errors import LaunchError
+from rosl.launch.parameter_files import ParameterFiles
+from rosl.launch.records import ExecutionComplete, ProcessEvent, ProcessSpec, ShutdownEvent
 from rosl.pkg import interrupts
 
 if TYPE_CHECKING:
@@ -49,47 +50,6 @@ def _prepare_child(hold_sigint: bool) -> None:  # runs in the child between fork
     interrupts.prepare_child(hold_sigint)
     with contextlib.suppress(OSError, AttributeError):  # die with the launcher
         ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-
-
-@dataclass(slots=True)
-class ProcessSpec:
-    """What to start, resolved from a launch action."""
-
-    name: str
-    cmd: list[str]
-    env: dict[str, str]
-    cwd: str | None = None
-    output: str = "log"
-    respawn: bool = False
-    respawn_delay: float = 0.0
-    emulate_tty: bool = False
-    sigterm_timeout: float = 5.0
-    sigkill_timeout: float = 5.0
-    details: dict[str, Any] = field(default_factory=dict)
-    background: bool = False  # e.g. the recorder: stopped after every other process ended
-
-
-@dataclass(slots=True)
-class ProcessEvent:
-    """A process started, printed a line or exited (what event handlers and watchers see)."""
-
-    kind: str  # "start" | "exit"; watchers also see "stdout" | "stderr"
-    action: Any
-    name: str
-    pid: int
-    returncode: int | None = None
-    cmd: list[str] = field(default_factory=list)
-    text: str = ""  # the line printed ("stdout"/"stderr" events), without its newline
-
-
-@dataclass(slots=True)
-class ShutdownEvent:
-    """The launch begins to shut down (what OnShutdown handlers see: launch's Shutdown event)."""
-
-    reason: str
-    due_to_sigint: bool = False
-    kind: str = "shutdown"
-    action: Any = None
 
 
 @dataclass(slots=True)
@@ -127,12 +87,13 @@ class Supervisor:
         self.failed: list[str] = []
         self.started = 0
         self._counter = itertools.count(1)
-        self._param_files = itertools.count(1)
+        self.parameter_files = ParameterFiles(self.log_dir, dry_run=dry_run)
         self._running: list[Running] = []
         self._handlers: list[tuple[Any, LaunchContext]] = []
         self._timers: list[tuple[float, int, Callable[[], None]]] = []
         self._timer_ids = itertools.count()
         self._respawns: list[tuple[float, int, ProcessSpec, Any, LaunchContext | None, str]] = []
+        self._respawned: dict[str, int] = {}  # label -> times respawned
         self._selector = selectors.DefaultSelector()
         self._shutdown_reason: str | None = None
         self._log_file: IO[str] | None = None
@@ -147,9 +108,10 @@ class Supervisor:
         self._watch: tuple[str, str] | None = None
         self._seen = False
         self.watchers: list[Callable[[ProcessEvent], None]] = []  # see every launched process
-        self._started: list[tuple[ProcessEvent, LaunchContext]] = []  # for the handlers, next
+        self._started: list[tuple[ProcessEvent | ExecutionComplete, LaunchContext]] = []  # next
         self.keep_alive = False  # run() goes on after the last process, until a shutdown
-        self._requests: list[str] = []  # shutdowns asked for by other threads
+        self._requests: list[tuple[str, float]] = []  # shutdowns asked for by other threads
+        self._entities: list[tuple[list[Any], LaunchContext]] = []  # from other threads too
         self._soon: collections.deque[Callable[[], None]] = collections.deque()  # other threads'
 
     # --- logging -----------------------------------------------------------------------------
@@ -181,18 +143,6 @@ class Supervisor:
         if handle is not None:
             handle.write(f"{time.time():.7f} {line}\n")
             handle.flush()
-
-    def parameter_file(self, label: str, values: dict[str, Any]) -> Path:
-        """Write a node's parameters as a ROS 2 parameter file; return its path."""
-        import yaml
-
-        folder = self.log_dir / "params"
-        path = folder / f"{label.replace('/', '_')}-{next(self._param_files)}.yaml"
-        if self.dry_run:  # --print writes nothing
-            return path
-        folder.mkdir(parents=True, exist_ok=True)
-        path.write_text(yaml.safe_dump({"/**": {"ros__parameters": values}}), encoding="utf-8")
-        return path
 
     # --- starting ----------------------------------------------------------------------------
 
@@ -243,6 +193,9 @@ class Supervisor:
             os.set_blocking(pipe.fileno(), False)
             self._selector.register(pipe, selectors.EVENT_READ, running)
         self.log("INFO", label, f"process started with pid [{popen.pid}]")
+        with contextlib.suppress(AttributeError):  # as launch's ExecuteProcess has them
+            action.process_details = {"name": label, "cmd": list(spec.cmd), "pid": popen.pid,
+                                      "cwd": spec.cwd, "env": spec.env}  # fmt: skip
         started = ProcessEvent("start", action, label, popen.pid, None, spec.cmd)
         self._notify(running, started)
         if context is not None:  # handlers see it from the loop, as launch's event queue has it:
@@ -282,12 +235,46 @@ class Supervisor:
             for watcher in self.watchers:
                 watcher(event)
 
-    def _emit(self, event: ProcessEvent | ShutdownEvent, context: LaunchContext | None) -> None:
-        from rosl.launch.description import process
+    def _emit(
+        self,
+        event: ProcessEvent | ShutdownEvent | ExecutionComplete,
+        context: LaunchContext | None,
+    ) -> None:
+        from rosl.launch.description import process_for_event
 
         for handler, handler_context in list(self._handlers):
             if handler.matches(event):
-                process(handler.entities(event, handler_context or context), handler_context)
+                process_for_event(handler, event, handler_context)
+
+    def completed(self, action: Any, context: LaunchContext) -> None:
+        """``action`` has done its work: the OnExecutionComplete handlers hear of it from the loop.
+
+        As launch's event queue has it: also those registered after the action.
+        """
+        self._started.append((ExecutionComplete(action), context))  # from the loop, in order
+
+    def request_entities(self, entities: list[Any], context: LaunchContext) -> None:
+        """Process launch entities on the supervising loop (from any thread)."""
+        self._entities.append((list(entities), context))
+
+    def shutdown_processes(self, matcher: Callable[[Any], bool]) -> None:
+        """Stop the processes whose action ``matcher`` accepts (SIGINT, then escalation)."""
+        for running in self._matching(matcher):
+            if not running.stopping:
+                self._signal(running, signal.SIGINT)
+
+    def signal_processes(self, matcher: Callable[[Any], bool], signum: int) -> None:
+        """Send ``signum`` to the processes whose action ``matcher`` accepts."""
+        for running in self._matching(matcher):
+            self.log("INFO", running.label, f"sending signal '{signal.Signals(signum).name}'")
+            try:
+                os.killpg(running.popen.pid, signum)
+            except (ProcessLookupError, PermissionError):
+                with contextlib.suppress(ProcessLookupError):
+                    running.popen.send_signal(signum)
+
+    def _matching(self, matcher: Callable[[Any], bool]) -> list[Running]:
+        return [r for r in self._running if r.action is not None and matcher(r.action)]
 
     # --- the loop ----------------------------------------------------------------------------
 
@@ -301,21 +288,68 @@ class Supervisor:
         """Whether a SIGINT or SIGTERM reached the launcher."""
         return self._interrupts > 0
 
-    def request_shutdown(self, reason: str) -> None:
-        """Ask for ``shutdown(reason)`` from any thread; the supervising loop does it (≤ 0.1 s)."""
-        self._requests.append(reason)
+    def request_shutdown(self, reason: str, grace: float = 0.0) -> None:
+        """Ask for ``shutdown(reason, grace)`` from any thread; the supervising loop does it."""
+        self._requests.append((reason, grace))
 
-    def shutdown(self, reason: str) -> None:
-        """Stop every process (SIGINT, then escalation) and start nothing more."""
+    def shutdown(self, reason: str, grace: float = 0.0) -> None:
+        """Stop every process (SIGINT, then escalation) and start nothing more.
+
+        ``grace``: seconds the processes get to end by themselves first (their output is read
+        meanwhile); a launch test gives its processes a moment once its tests are done, so one
+        that prints and ends at once is not caught by the SIGINT.
+        """
         if self._shutdown_reason is not None:
             return
         self._shutdown_reason = reason
         self._timers.clear()
         self._respawns.clear()
         self._emit(ShutdownEvent(reason, self._interrupts > 0), None)  # OnShutdown handlers
+        self._drain()
+        self._let_end(grace)
+        deadline = time.monotonic() + 1.0  # for all of them together
         for running in self._running:
-            if not running.spec.background:  # helpers (the recorder) stop after the rest
+            if running.spec.background:  # helpers (the recorder) stop after the rest
+                continue
+            if not self._ending_by_itself(running, deadline):
                 self._signal(running, signal.SIGINT)
+
+    def _drain(self) -> None:
+        """Read what the processes have printed so far (and which have closed their output)."""
+        for _ in range(100):  # bounded: a process printing without pause cannot hold us here
+            ready = self._selector.select(0)
+            if not ready:
+                return
+            for key, _ in ready:
+                self._read(cast("IO[bytes]", key.fileobj), key.data)
+
+    def _let_end(self, grace: float) -> None:
+        deadline = time.monotonic() + grace
+        while any(r.popen.poll() is None for r in self._running if not r.spec.background):
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return
+            for key, _ in self._selector.select(min(left, 0.02)):
+                self._read(cast("IO[bytes]", key.fileobj), key.data)
+
+    def _ending_by_itself(self, running: Running, deadline: float) -> bool:
+        """A process that has closed its stdout and stderr is exiting: let it (until deadline).
+
+        Else the SIGINT of a shutdown that comes just as it ends turns its clean exit into -2.
+        """
+        for pipe in (running.popen.stdout, running.popen.stderr):
+            if pipe is None:
+                continue
+            try:
+                self._selector.get_key(pipe)  # still open
+                return False
+            except KeyError:
+                continue
+        try:
+            running.popen.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            return False
+        return True
 
     def _signal(self, running: Running, signum: int) -> None:
         running.stopping = True
@@ -344,7 +378,12 @@ class Supervisor:
         while self._signals:
             self._handle_signal(self._signals.pop(0))
         while self._requests:
-            self.shutdown(self._requests.pop(0))
+            self.shutdown(*self._requests.pop(0))
+        while self._entities and self._shutdown_reason is None:
+            from rosl.launch.description import process
+
+            entities, context = self._entities.pop(0)
+            process(entities, context)
 
     def _handle_signal(self, signum: int) -> None:
         self._interrupts += 1
@@ -388,13 +427,18 @@ class Supervisor:
         self.loading = self._interrupt_pending = self._before_run = False
         try:
             self._handle_signals()  # any received while the launch file loaded
-            while self._running or (
-                self._shutdown_reason is None
-                and (self._timers or self._respawns or self.keep_alive)
+            while (
+                self._running
+                or self._started
+                or (
+                    self._shutdown_reason is None
+                    and (self._timers or self._respawns or self.keep_alive or self._entities)
+                )
             ):
                 self._handle_signals()
                 foreground = [r for r in self._running if not r.spec.background]
-                pending = self._timers or self._respawns or self.keep_alive
+                pending = (self._timers or self._respawns or self.keep_alive or self._started
+                           or self._entities)  # fmt: skip
                 if self._shutdown_reason is None and not foreground and not pending:
                     self.shutdown("all processes have finished")
                 if self._shutdown_reason is not None:
@@ -540,13 +584,18 @@ class Supervisor:
             on_exit = getattr(running.action, "on_exit", None)
             if on_exit is not None:  # ExecuteProcess(on_exit=...): a handler for itself
                 from rosl.launch.actions import OnProcessExit
-                from rosl.launch.description import process
+                from rosl.launch.description import process_for_event
 
                 own = OnProcessExit(target_action=running.action, on_exit=on_exit)
-                process(own.entities(event, running.context), running.context)
-        if running.spec.respawn and self._shutdown_reason is None:
+                process_for_event(own, event, running.context)
+        retries = running.spec.respawn_max_retries
+        if (running.spec.respawn and self._shutdown_reason is None
+                and (retries < 0 or self._respawned.get(running.label, 0) < retries)):  # fmt: skip
+            self._respawned[running.label] = self._respawned.get(running.label, 0) + 1
             self._respawns.append((time.monotonic() + running.spec.respawn_delay, pid, running.spec,
                                    running.action, running.context, running.label))  # fmt: skip
+        elif running.context is not None:  # its work is done (a respawned one goes on)
+            self.completed(running.action, running.context)
 
     def kill_all(self) -> None:
         """Make sure nothing is left running (SIGKILL to every process group)."""
@@ -561,10 +610,3 @@ def _default_log_dir() -> Path:
     base = os.environ.get("ROSL_LOG_DIR") or os.path.join(os.path.expanduser("~"), ".rosl", "log")
     stamp = datetime.datetime.now().strftime("%Y-%m-%d-%H-%M-%S-%f")
     return Path(base) / f"{stamp}-{socket.gethostname()}-{os.getpid()}"
-
-
-def check_output(value: str) -> str:
-    """Validate an ``output=`` value."""
-    if value not in ("screen", "log", "both", "own_log", "full"):
-        raise LaunchError(f"output='{value}' is not one of 'screen', 'log', 'both'")
-    return value

@@ -537,8 +537,8 @@ def test_a_missing_parameter_file_is_one_error_line_and_leaves_nothing_running(
     launch = rosl.start("launch", str(path))
 
     assert launch.finish() == 1, launch.both()
-    assert one_error_line(launch.text("err")).startswith(f"parameter file {missing} "), (
-        launch.both()
-    )
+    assert one_error_line(launch.text("err")).startswith(  # the line of its Node(...)
+        f"{path}:8: parameter file {missing} "
+    ), launch.both()
     if launch.pids():
         assert_all_gone(launch.pids())

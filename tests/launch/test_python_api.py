@@ -269,15 +269,15 @@ def test_real_component_launch_files_are_refused_in_one_line(
             "which rosl cannot: image_tools::Cam2Image",
         ),
         (
-            "launch.actions.EmitEvent(event=launch.events.process.ShutdownProcess())",
+            "launch.actions.ExecuteLocal(process_description=None)",
             6,
-            "'launch.events.process.ShutdownProcess' is not supported by rosl",
+            "'launch.actions.ExecuteLocal' is not supported by rosl",
         ),
         (
             "launch_ros.actions.Node(package='tutorial_pkg', executable='timer_node', "
-            "parameters=[launch_ros.descriptions.ParameterFile('p.yaml', allow_substs=True)])",
+            "parameters=[42])",
             6,
-            "ParameterFile(allow_substs=True) is not supported by rosl",
+            "parameters of timer_node must be dicts or YAML file paths, not int",
         ),
         (
             "launch.actions.LogInfo(msg=get_package_share_directory('no_such_package'))",

@@ -273,7 +273,7 @@ ERRORS = [
     ("<launch>\n  <log message='x' if='maybe'/>\n</launch>", 2,
      "Unknown value for condition: 'maybe'"),
     ("<launch>\n  <group scoped='perhaps'/>\n</launch>", 2,
-     "attribute 'scoped' of <group> must be true or false, not 'perhaps'"),
+     "attribute 'scoped' of <group> must be a boolean (true/false, yes/no, on/off), not 'perhaps'"),
     ("<launch>\n  <let name='a' value=\"$(command 'false')\"/>\n</launch>", 2,
      "command 'false' exited with code 1"),
     ("<launch>\n  <let name='a' value=\"$(command 'sh -c &quot;echo oops &gt;&amp;2&quot;')\"/>"

@@ -307,8 +307,9 @@ def test_yaml_parameters_keep_their_yaml_types(
          "bad substitution in '$(var x': '$(var' at column 1 is not closed with ')'"),
         ("launch:\n- node:\n    pkg: tutorial_pkg\n    exec: timer_node\n    param:\n"
          "    - {name: a, vlue: 1}\n", 6, "unknown attribute 'vlue' in 'param' (did you mean"),
-        ("launch:\n- group: {scoped: 'no', children: []}\n", 2,
-         "attribute 'scoped' of 'group' must be true or false, not 'no'"),
+        ("launch:\n- group: {scoped: 'perhaps', children: []}\n", 2,
+         "attribute 'scoped' of 'group' must be a boolean (true/false, yes/no, on/off), "
+         "not 'perhaps'"),
         ("launch:\n- group: {scoped: true}\n", 2, "'group' needs 'children:'"),
         ("launch:\n- arg: {name: x}\n- log: {message: $(var y)}\n", 3,
          "launch configuration 'y' is not set: declare it with '- arg: {name: y, default: ...}'"),

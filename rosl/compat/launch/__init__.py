@@ -11,6 +11,7 @@ from rosl.compat.unsupported import unsupported_names
 from rosl.launch.context import LaunchContext
 from rosl.launch.description import Action, Condition, LaunchDescription
 from rosl.launch.event_handlers import EventHandler
+from rosl.launch.service import LaunchService
 from rosl.launch.substitutions import SomeSubstitutions as SomeSubstitutionsType
 from rosl.launch.substitutions import Substitution
 
@@ -20,13 +21,15 @@ __all__ = [
     "EventHandler",
     "LaunchContext",
     "LaunchDescription",
+    "LaunchService",
     "SomeSubstitutionsType",
     "Substitution",
 ]
 
 _SUBMODULES = frozenset(
-    ("actions", "conditions", "event_handlers", "events", "launch_description_sources",
-     "substitutions", "utilities")
+    ("action", "actions", "condition", "conditions", "event_handler", "event_handlers", "events",
+     "launch_context", "launch_description", "launch_description_sources", "logging",
+     "some_substitutions_type", "substitution", "substitutions", "utilities")
 )  # fmt: skip
 _unsupported = unsupported_names("launch", [*__all__, *sorted(_SUBMODULES)])
 

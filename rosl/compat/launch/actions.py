@@ -10,6 +10,7 @@ from rosl.launch.actions import (
     IncludeLaunchDescription,
     LogInfo,
     OpaqueFunction,
+    ResetLaunchConfigurations,
     SetEnvironmentVariable,
     SetLaunchConfiguration,
     Shutdown,
@@ -17,17 +18,21 @@ from rosl.launch.actions import (
     UnsetEnvironmentVariable,
 )
 from rosl.launch.event_handlers import RegisterEventHandler
+from rosl.launch.loops import ForEach, ForLoop
 
 __all__ = [
     "AppendEnvironmentVariable",
     "DeclareLaunchArgument",
     "EmitEvent",
     "ExecuteProcess",
+    "ForEach",
+    "ForLoop",
     "GroupAction",
     "IncludeLaunchDescription",
     "LogInfo",
     "OpaqueFunction",
     "RegisterEventHandler",
+    "ResetLaunchConfigurations",
     "SetEnvironmentVariable",
     "SetLaunchConfiguration",
     "Shutdown",

@@ -7,8 +7,11 @@ from rosl.launch.ros_actions import (
     LoadComposableNodes,
     Node,
     PushRosNamespace,
+    RosTimer,
     SetParameter,
+    SetParametersFromFile,
     SetRemap,
+    SetUseSimTime,
 )
 
 PushROSNamespace = PushRosNamespace  # the later distros' spelling
@@ -21,7 +24,10 @@ __all__ = [
     "Node",
     "PushROSNamespace",
     "PushRosNamespace",
+    "RosTimer",
     "SetParameter",
+    "SetParametersFromFile",
     "SetRemap",
+    "SetUseSimTime",
 ]
 __getattr__ = unsupported_names("launch_ros.actions", __all__)

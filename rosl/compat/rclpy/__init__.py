@@ -64,6 +64,8 @@ _SUBMODULES = frozenset(
 
 
 def __getattr__(name: str) -> Any:
+    if name in ("Context", "Parameter"):  # rclpy has them at the top too (tests use them)
+        return getattr(importlib.import_module(f"rclpy.{name.lower()}"), name)
     if name in _SUBMODULES:
         return importlib.import_module(f"rclpy.{name}")
     raise AttributeError(f"module 'rclpy' has no attribute '{name}'")

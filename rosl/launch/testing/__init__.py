@@ -18,10 +18,10 @@ if TYPE_CHECKING:
 T = TypeVar("T")
 
 _SUBMODULES = (
-    "actions", "asserts", "io_handler", "launch_test", "loader", "markers",
-    "proc_info_handler", "test_runner", "util",
+    "actions", "asserts", "io_handler", "junitxml", "launch_test", "loader", "markers",
+    "proc_info_handler", "process_proxy", "test_runner", "tools", "util",
 )  # fmt: skip
-_NOT_IN_ROSL = ("parametrize", "tools", "junitxml", "legacy")
+_NOT_IN_ROSL = ("legacy",)
 
 
 def post_shutdown_test() -> Callable[[T], T]:
@@ -46,6 +46,10 @@ def ready_to_test_action_timeout(timeout: float) -> Callable[[T], T]:
 
 def __getattr__(name: str) -> Any:
     """Load a submodule on first use; name what rosl's launch_testing leaves out."""
+    if name == "parametrize":
+        from rosl.launch.testing.parametrize import parametrize
+
+        return parametrize
     if name in _SUBMODULES:
         return importlib.import_module(f"{__name__}.{name}")
     if name in _NOT_IN_ROSL:
@@ -53,7 +57,8 @@ def __getattr__(name: str) -> Any:
 
         raise LaunchError(
             f"'launch_testing.{name}' is not supported by rosl (it provides: actions, asserts, "
-            "markers, util, post_shutdown_test, ready_to_test_action_timeout)"
+            "markers, tools, util, parametrize, post_shutdown_test, "
+            "ready_to_test_action_timeout)"
         )
     raise AttributeError(f"module 'launch_testing' has no attribute '{name}'")
 

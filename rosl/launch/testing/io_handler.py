@@ -61,6 +61,11 @@ class ActiveIoHandler:
         self._sync_lock = threading.Condition()
         self._io_handler = IoHandler()
 
+    @property
+    def io_event(self) -> threading.Condition:
+        """The condition notified on every line and every started process."""
+        return self._sync_lock
+
     def track(self, action: Any, details: dict[str, Any]) -> None:
         """Know a started process."""
         with self._sync_lock:

@@ -70,11 +70,29 @@ def user_error(path: Path, err: BaseException) -> LaunchError:
     return LaunchError(f"{path}:{line}: {what}")
 
 
+def test_runs(module: ModuleType, path: Path) -> list[TestRun]:
+    """The launches of a test file: one, or one per value of ``launch_testing.parametrize``.
+
+    Raises:
+        LaunchError: no generate_test_description.
+    """
+    function = getattr(module, "generate_test_description", None)
+    if callable(function) and getattr(function, "__parametrized__", False):
+        return [TestRun(module, path, bound, values) for bound, values in function()]
+    return [TestRun(module, path)]
+
+
 class TestRun:
     """One launch of a test file: its description function, active and post-shutdown tests."""
 
-    def __init__(self, module: ModuleType, path: Path) -> None:
-        function = getattr(module, "generate_test_description", None)
+    def __init__(
+        self,
+        module: ModuleType,
+        path: Path,
+        function: Callable[..., Any] | None = None,
+        parameters: dict[str, Any] | None = None,
+    ) -> None:
+        function = function or getattr(module, "generate_test_description", None)
         if not callable(function):
             raise LaunchError(
                 f"{path}: no generate_test_description() function; a launch test must define "
@@ -82,7 +100,9 @@ class TestRun:
             )
         self.module = module
         self.path = path
-        self.name = module.__name__
+        self.parameters = dict(parameters or {})
+        shown = ", ".join(f"{k}={v}" for k, v in self.parameters.items())
+        self.name = module.__name__ + (f"[{shown}]" if parameters is not None else "")
         self.function: Callable[..., Any] = function
         self.markers: dict[str, Any] = dict(getattr(function, "__markers__", {}))
         self.timeout = float(

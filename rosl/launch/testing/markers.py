@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import time
 from typing import TYPE_CHECKING, Any, TypeVar
 
 if TYPE_CHECKING:
@@ -26,8 +27,13 @@ def keep_alive(test_description: T) -> T:
     return test_description
 
 
-def retry_on_failure(*, times: int) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
-    """Run a test method up to ``times`` times while it fails with an AssertionError."""
+def retry_on_failure(
+    *, times: int, delay: float | None = None
+) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Run a test method up to ``times`` times while it fails with an AssertionError.
+
+    ``delay``: seconds to wait before each retry.
+    """
     if times < 1:
         raise ValueError("retry_on_failure(times=...) needs at least 1")
 
@@ -38,7 +44,8 @@ def retry_on_failure(*, times: int) -> Callable[[Callable[..., Any]], Callable[.
                 try:
                     return function(self, *args, **kwargs)
                 except AssertionError:
-                    continue
+                    if delay:
+                        time.sleep(delay)
             return function(self, *args, **kwargs)
 
         return wrapper

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import sys
 import threading
+import time
 import unittest
 from dataclasses import dataclass, field
 from typing import IO, TYPE_CHECKING, Any
@@ -24,10 +25,13 @@ from rosl.launch.testing.proc_info_handler import (
 )
 
 if TYPE_CHECKING:
-    from rosl.launch.supervisor import ProcessEvent, Supervisor
+    from rosl.launch.context import LaunchContext
+    from rosl.launch.records import ProcessEvent
+    from rosl.launch.supervisor import Supervisor
     from rosl.launch.testing.loader import TestRun
 
 DIED = "Processes under test stopped before tests completed"
+GRACE_SEC = 0.5  # once the active tests are done: a process ending just then ends by itself
 
 
 @dataclass(slots=True)
@@ -51,15 +55,58 @@ class RunResult:
         ]
 
 
+class TimedTestResult(unittest.TextTestResult):
+    """unittest's verbose result, also keeping every test run and its time (for JUnit XML)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.testCases: list[unittest.TestCase] = []
+        self.testTimes: dict[unittest.TestCase, float] = {}
+        self._started_at = 0.0
+
+    def startTest(self, test: unittest.TestCase) -> None:  # noqa: N802 - unittest's name
+        """Note the start."""
+        self._started_at = time.monotonic()
+        super().startTest(test)
+
+    def stopTest(self, test: unittest.TestCase) -> None:  # noqa: N802 - unittest's name
+        """Note the time taken."""
+        super().stopTest(test)
+        self.testCases.append(test)
+        self.testTimes[test] = time.monotonic() - self._started_at
+
+
 class LaunchServiceHandle:
-    """What tests get as ``launch_service``: a way to end the launch early."""
+    """What tests get as ``launch_service``: end the launch early, or emit events into it."""
 
     def __init__(self, supervisor: Supervisor) -> None:
         self._supervisor = supervisor
+        self.context: LaunchContext | None = None  # the launch's, once it runs
 
     def shutdown(self) -> None:
         """Stop the launched processes (from any thread)."""
         self._supervisor.request_shutdown("shutdown requested by a test")
+
+    def emit_event(self, event: Any) -> None:
+        """Act on an event from any thread, on the supervising loop (as launch's queue does).
+
+        ``launch.events.IncludeLaunchDescription`` adds a description to the running launch;
+        ``Shutdown``, ``ShutdownProcess`` and ``SignalProcess`` act as EmitEvent does.
+
+        Raises:
+            LaunchError: another event, or no launch running.
+        """
+        from rosl.launch.actions import EmitEvent
+        from rosl.launch.errors import LaunchError
+        from rosl.launch.events import IncludeLaunchDescription
+
+        if self.context is None:
+            raise LaunchError("launch_service.emit_event(): the launch is not running")
+        if isinstance(event, IncludeLaunchDescription):
+            entities = list(event.launch_description.entities)
+        else:
+            entities = [EmitEvent(event=event)]
+        self._supervisor.request_entities(entities, self.context)
 
 
 class LaunchTestRunner:
@@ -86,6 +133,7 @@ class LaunchTestRunner:
         self._completed = threading.Event()
         self._active: unittest.TestResult | None = None
         self._thread = threading.Thread(target=self._run_active, name="launch_test", daemon=True)
+        self.launch_service = LaunchServiceHandle(self.supervisor)
 
     def run(self) -> RunResult:
         """Launch, run the active tests, shut down, run the post-shutdown tests.
@@ -125,6 +173,7 @@ class LaunchTestRunner:
         supervisor.log("INFO", "launch", "Default logging verbosity is set to INFO")
         context = LaunchContext(supervisor, self.arguments)
         context.files.append(self.test_run.path)
+        self.launch_service.context = context
         self._thread.start()
         try:
             check_required_arguments(description, context, self.test_run.path)
@@ -138,10 +187,10 @@ class LaunchTestRunner:
         supervisor.run()
 
     def _bind(self, values: dict[str, Any]) -> None:
-        common = {**values, "test_args": dict(self.arguments)}
+        common = {**values, **self.test_run.parameters, "test_args": dict(self.arguments)}
         self.test_run.bind(self.test_run.pre_shutdown_tests, {
             **common, "proc_info": self.proc_info, "proc_output": self.proc_output,
-            "launch_service": LaunchServiceHandle(self.supervisor),
+            "launch_service": self.launch_service,
         })  # fmt: skip
         self.test_run.bind(self.test_run.post_shutdown_tests, {
             **common, "proc_info": self.proc_info._proc_info_handler,
@@ -176,10 +225,12 @@ class LaunchTestRunner:
             self._active = self._unittest(self.test_run.pre_shutdown_tests)
         finally:
             self._completed.set()
-            self.supervisor.request_shutdown("the active tests have finished")
+            self.supervisor.request_shutdown("the active tests have finished", grace=GRACE_SEC)
 
     def _unittest(self, suite: unittest.TestSuite) -> unittest.TestResult:
-        runner = unittest.TextTestRunner(stream=self.stream or sys.stderr, verbosity=2)
+        runner = unittest.TextTestRunner(
+            stream=self.stream or sys.stderr, verbosity=2, resultclass=TimedTestResult
+        )
         return runner.run(suite)
 
     def _print(self, text: str) -> None:

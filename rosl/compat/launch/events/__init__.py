@@ -1,13 +1,13 @@
-"""launch.events: ``Shutdown`` (an event EmitEvent takes) and ``matches_action``."""
+"""launch.events: ``Shutdown``, ``IncludeLaunchDescription`` and ``matches_action``."""
 
 import importlib
 from typing import Any
 
 from rosl.compat.unsupported import unsupported_names
 from rosl.launch.actions import Shutdown
-from rosl.launch.lifecycle_events import matches_action
+from rosl.launch.events import IncludeLaunchDescription, matches_action
 
-__all__ = ["Shutdown", "matches_action"]
+__all__ = ["IncludeLaunchDescription", "Shutdown", "matches_action"]
 _unsupported = unsupported_names("launch.events", __all__)
 
 

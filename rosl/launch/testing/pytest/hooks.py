@@ -105,11 +105,11 @@ class LaunchTestModule(pytest.File):
     def collect(self) -> list[pytest.Item]:
         """One item: the file's launch and all its tests."""
         from rosl.launch.errors import LaunchError
-        from rosl.launch.testing.loader import TestRun, load_test_module
+        from rosl.launch.testing.loader import load_test_module, test_runs
 
         try:
             module = load_test_module(self.path)
-            TestRun(module, self.path)
+            test_runs(module, self.path)
         except LaunchError as err:
             raise self.CollectError(str(err)) from None
         item = LaunchTestItem.from_parent(self, name=module.__name__)
@@ -125,16 +125,21 @@ class LaunchTestItem(pytest.Item):
     def runtest(self) -> None:
         """Launch and test; raise LaunchTestFailure when something failed."""
         from rosl.launch.loader import parse_arguments
-        from rosl.launch.testing.loader import TestRun
+        from rosl.launch.testing.loader import test_runs
         from rosl.launch.testing.test_runner import LaunchTestRunner
 
         given = [text for group in self.config.getoption("--launch-args") or [] for text in group]
-        test_run = TestRun(self.module, self.path)  # fresh test cases every run
-        result = LaunchTestRunner(test_run, parse_arguments(given)).run()
-        if result.interrupted:
-            raise KeyboardInterrupt
-        if not result.wasSuccessful():
-            raise LaunchTestFailure(result.failures(), result.problem)
+        failures: list[tuple[str, str]] = []
+        problems: list[str] = []
+        for test_run in test_runs(self.module, self.path):  # fresh test cases every run
+            result = LaunchTestRunner(test_run, parse_arguments(given)).run()
+            if result.interrupted:
+                raise KeyboardInterrupt
+            failures += result.failures()
+            if result.problem:
+                problems.append(f"{test_run.name}: {result.problem}")
+        if failures or problems:
+            raise LaunchTestFailure(failures, "; ".join(problems) or None)
 
     def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException], style: Any = None) -> Any:
         """Each failed test and its traceback, as unittest printed it; one line for a mistake."""
