@@ -35,8 +35,9 @@ __all__ = [
 
 
 _SUBMODULES = frozenset(
-    ("callback_groups", "client", "clock", "context", "duration", "exceptions", "executors",
-     "guard_condition", "logging", "node", "parameter", "publisher", "qos", "service", "signals",
+    ("callback_groups", "client", "clock", "context", "duration", "event_handler", "exceptions",
+     "executors", "guard_condition", "logging", "node", "parameter", "publisher", "qos",
+     "qos_event", "qos_overriding_options", "service", "signals",
      "subscription", "task", "time", "timer", "utilities", "waitable")
 )  # fmt: skip
 
