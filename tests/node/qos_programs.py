@@ -146,8 +146,45 @@ rclpy.spin(node)
 )
 
 
-def start(spawn: Any, tmp_path: Path, source: str, name: str, cfg: dict[str, Any]) -> Any:
-    """Run one program (as rclpy code) with its settings."""
+def write(tmp_path: Path, source: str, name: str) -> str:
+    """Write one program to a file; return its path."""
     script = tmp_path / f"{name}.py"
     script.write_text(snippet(source))
-    return spawn(RUN_AS_RCLPY, str(script), json.dumps({"name": name, **cfg}))
+    return str(script)
+
+
+def start(spawn: Any, tmp_path: Path, source: str, name: str, cfg: dict[str, Any]) -> Any:
+    """Run one program (as rclpy code) with its settings."""
+    return spawn(RUN_AS_RCLPY, write(tmp_path, source, name), json.dumps({"name": name, **cfg}))
+
+OVERRIDDEN = (
+    PROFILE
+    + """
+from rclpy.qos import QoSPolicyKind
+from rclpy.qos_overriding_options import QoSOverridingOptions
+from std_msgs.msg import String
+
+rclpy.init()
+node = rclpy.create_node(cfg.get("name", "overridden"))
+
+
+def reasonable(qos):
+    return qos.depth <= 100
+
+
+kinds = [QoSPolicyKind[k] for k in cfg["kinds"]] if "kinds" in cfg else None
+options = (QoSOverridingOptions(kinds, callback=reasonable, entity_id=cfg.get("entity_id"))
+           if kinds else QoSOverridingOptions.with_default_policies(
+               callback=reasonable, entity_id=cfg.get("entity_id")))
+pub = node.create_publisher(String, "qos_chatter", profile(cfg), qos_overriding_options=options)
+sub = node.create_subscription(String, "qos_chatter", lambda m: None, profile(cfg),
+                               qos_overriding_options=options)
+for entity in ("publisher", "subscription"):
+    qos = pub.qos_profile if entity == "publisher" else sub.qos_profile
+    say(f"{entity} history={qos.history.name} depth={qos.depth} "
+        f"reliability={qos.reliability.name} durability={qos.durability.name} "
+        f"deadline={qos.deadline.nanoseconds}")
+say("ready")
+rclpy.spin(node)
+"""
+)
