@@ -157,6 +157,7 @@ def start(spawn: Any, tmp_path: Path, source: str, name: str, cfg: dict[str, Any
     """Run one program (as rclpy code) with its settings."""
     return spawn(RUN_AS_RCLPY, write(tmp_path, source, name), json.dumps({"name": name, **cfg}))
 
+
 OVERRIDDEN = (
     PROFILE
     + """
