@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rosl.node.qos import QoSPolicyKind
 
@@ -72,6 +72,27 @@ class QoSMessageLostInfo:
     total_count_change: int = 0
 
 
+@dataclass(slots=True)
+class QoSSubscriptionMatchedInfo:
+    """The compatible publishers a subscription matches: all told, and now (Jazzy)."""
+
+    total_count: int = 0
+    total_count_change: int = 0
+    current_count: int = 0
+    current_count_change: int = 0
+
+
+QoSPublisherMatchedInfo = QoSSubscriptionMatchedInfo
+
+
+@dataclass(slots=True)
+class IncompatibleTypeInfo:
+    """Endpoints found on the topic with another message type (Jazzy)."""
+
+    total_count: int = 0
+    total_count_change: int = 0
+
+
 class QoSPublisherEventType(enum.IntEnum):
     """rcl's publisher event types."""
 
@@ -107,8 +128,8 @@ class SubscriptionEventCallbacks:
         incompatible_qos: Callable[[QoSRequestedIncompatibleQoSInfo], None] | None = None,
         liveliness: Callable[[QoSLivelinessChangedInfo], None] | None = None,
         message_lost: Callable[[QoSMessageLostInfo], None] | None = None,
-        incompatible_type: Callable[[Any], None] | None = None,
-        matched: Callable[[Any], None] | None = None,
+        incompatible_type: Callable[[IncompatibleTypeInfo], None] | None = None,
+        matched: Callable[[QoSSubscriptionMatchedInfo], None] | None = None,
         use_default_callbacks: bool = True,
     ) -> None:
         self.deadline = deadline
@@ -129,8 +150,8 @@ class PublisherEventCallbacks:
         deadline: Callable[[QoSOfferedDeadlineMissedInfo], None] | None = None,
         liveliness: Callable[[QoSLivelinessLostInfo], None] | None = None,
         incompatible_qos: Callable[[QoSOfferedIncompatibleQoSInfo], None] | None = None,
-        incompatible_type: Callable[[Any], None] | None = None,
-        matched: Callable[[Any], None] | None = None,
+        incompatible_type: Callable[[IncompatibleTypeInfo], None] | None = None,
+        matched: Callable[[QoSPublisherMatchedInfo], None] | None = None,
         use_default_callbacks: bool = True,
     ) -> None:
         self.deadline = deadline

@@ -10,7 +10,9 @@ the executor that runs the node, as rclpy's event handlers do:
 * liveliness: a subscription's matched publishers becoming alive or not (an automatic one is
   alive while its process is in the graph; a manual-by-topic one while it publishes or asserts
   within its lease); a manual-by-topic publisher that let its lease run out loses liveliness;
-* message lost: sequence gaps the bus counted on the subscription's topic.
+* message lost: sequence gaps the bus counted on the subscription's topic;
+* matched (Jazzy): the compatible endpoints of the other side, as they come and go;
+  incompatible type (Jazzy): endpoints on the topic with another message type.
 """
 
 from __future__ import annotations
@@ -24,12 +26,14 @@ from rosl.node.clock import Clock, ClockType
 from rosl.node.qos import LivelinessPolicy, duration_ns, qos_policy_name_from_kind
 from rosl.node.qos_compatibility import Mismatch, mismatches
 from rosl.node.qos_events import (
+    IncompatibleTypeInfo,
     QoSLivelinessChangedInfo,
     QoSLivelinessLostInfo,
     QoSMessageLostInfo,
     QoSOfferedDeadlineMissedInfo,
     QoSRequestedDeadlineMissedInfo,
     QoSRequestedIncompatibleQoSInfo,
+    QoSSubscriptionMatchedInfo,
 )
 
 if TYPE_CHECKING:
@@ -102,6 +106,10 @@ class _Watched:
         self.kind = kind  # PUBLISHER or SUBSCRIPTION
         self.words = entity.qos_profile.words()
         self.incompatible = Incompatible()
+        self.wrong_types: set[tuple[int, int]] = set()  # endpoints of another type, told
+        self.wrong_type_total = 0
+        self.matched: set[tuple[int, int]] = set()
+        self.matched_total = 0
         self.deadline = Deadline(duration_ns(entity.qos_profile.deadline))
         self.lease_ns = duration_ns(entity.qos_profile.liveliness_lease_duration)
         self.lost_told = 0
@@ -182,7 +190,7 @@ class QoSWatch:
         if generation != self.generation:
             self.generation = generation
             for watched in self.watched:
-                self._incompatible(watched, graph)
+                self._graph_events(watched, graph)
         now = time.time_ns()
         for watched in self.watched:
             if watched.kind == PUBLISHER:
@@ -190,29 +198,56 @@ class QoSWatch:
             else:
                 self._subscription_timing(watched, now, graph)
 
-    # --- incompatible QoS --------------------------------------------------------------------
+    # --- what the graph shows: incompatible QoS or type, matches ----------------------------
 
-    def _incompatible(self, watched: _Watched, graph: GraphCache) -> None:
+    def _graph_events(self, watched: _Watched, graph: GraphCache) -> None:
         entity = watched.entity
         other = SUBSCRIPTION if watched.kind == PUBLISHER else PUBLISHER
         state = watched.incompatible
-        change = 0
+        change = wrong_types = 0
+        matched: set[tuple[int, int]] = set()
         for node, endpoint in graph.endpoints(other, entity.topic):
             key = (node.process, endpoint.endpoint)
-            if key in state.seen or endpoint.type != entity.type_name:
+            if endpoint.type != entity.type_name:
+                if key not in watched.wrong_types:
+                    watched.wrong_types.add(key)
+                    wrong_types += 1
                 continue
             if watched.kind == PUBLISHER:
                 found = mismatches(watched.words, endpoint.qos)
             else:
                 found = mismatches(endpoint.qos, watched.words)
-            if found:
+            if not found:
+                matched.add(key)
+            elif key not in state.seen:
                 state.seen.add(key)
                 state.last = found[-1]
                 change += 1
-        if not change or state.last is None:
+        if change and state.last is not None:
+            state.total += change
+            self._tell_incompatible(
+                watched, QoSRequestedIncompatibleQoSInfo(state.total, change, state.last.kind)
+            )
+        callback = watched.callback("incompatible_type")
+        watched.wrong_type_total += wrong_types
+        if wrong_types and callback is not None:
+            callback(IncompatibleTypeInfo(watched.wrong_type_total, wrong_types))
+        self._tell_matched(watched, matched)
+
+    def _tell_matched(self, watched: _Watched, matched: set[tuple[int, int]]) -> None:
+        before = watched.matched
+        added = len(matched - before)
+        if matched == before:
             return
-        state.total += change
-        info = QoSRequestedIncompatibleQoSInfo(state.total, change, state.last.kind)
+        watched.matched = matched
+        watched.matched_total += added
+        callback = watched.callback("matched")
+        if callback is not None:
+            callback(QoSSubscriptionMatchedInfo(
+                watched.matched_total, added, len(matched), len(matched) - len(before)
+            ))  # fmt: skip
+
+    def _tell_incompatible(self, watched: _Watched, info: QoSRequestedIncompatibleQoSInfo) -> None:
         callback = watched.callback("incompatible_qos")
         if callback is not None:
             callback(info)

@@ -64,6 +64,9 @@ if cfg.get("callbacks", True):
         deadline=lambda e: say(
             f"offered deadline missed total={e.total_count} change={e.total_count_change}"),
         liveliness=lambda e: on_lost(e),
+        matched=lambda e: say(
+            f"publisher matched total={e.total_count} change={e.total_count_change} "
+            f"current={e.current_count} current_change={e.current_count_change}"),
     )
 topic = cfg.get("topic", "qos_chatter")
 pub = node.create_publisher(String, topic, profile(cfg), event_callbacks=callbacks)
@@ -135,6 +138,8 @@ if cfg.get("callbacks", True):
             f"alive_change={e.alive_count_change} not_alive_change={e.not_alive_count_change}"),
         message_lost=lambda e: say(
             f"message lost total={e.total_count} change={e.total_count_change}"),
+        incompatible_type=lambda e: say(
+            f"incompatible type total={e.total_count} change={e.total_count_change}"),
     )
 for topic in cfg.get("topics", ["qos_chatter"]):
     node.create_subscription(

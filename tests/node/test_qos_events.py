@@ -3,7 +3,9 @@ and message loss, with the event callbacks of rclpy.qos_event / rclpy.event_hand
 
 from __future__ import annotations
 
+import itertools
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -175,3 +177,68 @@ def test_messages_lost_while_the_subscriber_was_stopped_are_told(spawn, tmp_path
     found = listener.expect(r"^message lost total=(\d+) change=(\d+)$", timeout=BOUND)
     assert int(found.group(1)) > 0
     assert int(found.group(2)) > 0
+
+
+def test_matched_events_follow_compatible_subscriptions_only(spawn, tmp_path):
+    talker = start(spawn, tmp_path, TALKER, "talker", {"reliability": "BEST_EFFORT"})
+    talker.expect(r"^ready$", timeout=BOUND)
+    first = start(spawn, tmp_path, LISTENER, "first", {"reliability": "BEST_EFFORT"})
+    talker.expect(r"^publisher matched total=1 change=1 current=1 current_change=1$", timeout=BOUND)
+    start(spawn, tmp_path, LISTENER, "refused", {"reliability": "RELIABLE"})
+    talker.expect(r"^offered incompatible total=1 change=1 policy=RELIABILITY$", timeout=BOUND)
+    first.stop()
+
+    talker.expect(
+        r"^publisher matched total=1 change=0 current=0 current_change=-1$", timeout=BOUND
+    )
+    assert talker.count(r"current=2") == 0
+
+
+def test_an_endpoint_of_another_type_is_an_incompatible_type_event(spawn, tmp_path):
+    listener = start(spawn, tmp_path, LISTENER, "listener", {})
+    listener.expect(r"^ready$", timeout=BOUND)
+    spawn(
+        "import rosl\n"
+        "from std_msgs.msg import Int32\n"
+        "rosl.init()\n"
+        "node = rosl.Node('other_type')\n"
+        "node.create_publisher(Int32, 'qos_chatter', 10)\n"
+        "rosl.spin(node)\n"
+    )
+
+    listener.expect(r"^incompatible type total=1 change=1$", timeout=BOUND)
+
+
+def gaps(numbers):
+    """The jumps of more than one in a sequence of message numbers."""
+    return [b - a for a, b in itertools.pairwise(numbers) if b - a > 1]
+
+
+def _heard(listener, topic):
+    listener.pump()
+    return [
+        int(n) for n in re.findall(rf"^heard on {topic}: msg (\d+)$", listener.text["out"], re.M)
+    ]
+
+
+def test_messages_past_their_lifespan_when_taken_are_not_delivered(spawn, tmp_path):
+    deep = {"depth": 100}
+    start(spawn, tmp_path, TALKER, "short", {**deep, "topic": "short_lived", "lifespan": 0.5})
+    start(spawn, tmp_path, TALKER, "lasting", {**deep, "topic": "lasting"})
+    listener = start(spawn, tmp_path, LISTENER, "listener",
+                     {**deep, "topics": ["short_lived", "lasting"]})  # fmt: skip
+    listener.expect(r"^heard on short_lived: msg \d+$", timeout=BOUND)
+    listener.expect(r"^heard on lasting: msg \d+$", timeout=BOUND)
+
+    os.kill(listener.popen.pid, signal.SIGSTOP)  # messages wait in its socket meanwhile
+    try:
+        time.sleep(3.0)  # six lifespans
+    finally:
+        os.kill(listener.popen.pid, signal.SIGCONT)
+    before = len(_heard(listener, "short_lived"))
+    while len(_heard(listener, "short_lived")) < before + 5:
+        listener.expect(r"^heard on short_lived: msg \d+$", timeout=BOUND)
+
+    assert gaps(_heard(listener, "short_lived"))  # the stale ones were dropped
+    assert not gaps(_heard(listener, "lasting"))  # the same wait loses nothing without lifespan
+    assert listener.count(r"^message lost") == 0

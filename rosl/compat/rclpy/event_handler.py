@@ -1,6 +1,7 @@
 """rclpy.event_handler (Jazzy's name for rclpy.qos_event)."""
 
 from rosl.node.qos_events import (
+    IncompatibleTypeInfo,
     PublisherEventCallbacks,
     QoSLivelinessChangedInfo,
     QoSLivelinessLostInfo,
@@ -8,14 +9,17 @@ from rosl.node.qos_events import (
     QoSOfferedDeadlineMissedInfo,
     QoSOfferedIncompatibleQoSInfo,
     QoSPublisherEventType,
+    QoSPublisherMatchedInfo,
     QoSRequestedDeadlineMissedInfo,
     QoSRequestedIncompatibleQoSInfo,
     QoSSubscriptionEventType,
+    QoSSubscriptionMatchedInfo,
     SubscriptionEventCallbacks,
     UnsupportedEventTypeError,
 )
 
 __all__ = [
+    "IncompatibleTypeInfo",
     "PublisherEventCallbacks",
     "QoSLivelinessChangedInfo",
     "QoSLivelinessLostInfo",
@@ -23,9 +27,11 @@ __all__ = [
     "QoSOfferedDeadlineMissedInfo",
     "QoSOfferedIncompatibleQoSInfo",
     "QoSPublisherEventType",
+    "QoSPublisherMatchedInfo",
     "QoSRequestedDeadlineMissedInfo",
     "QoSRequestedIncompatibleQoSInfo",
     "QoSSubscriptionEventType",
+    "QoSSubscriptionMatchedInfo",
     "SubscriptionEventCallbacks",
     "UnsupportedEventTypeError",
 ]
