@@ -93,6 +93,8 @@ def _incompatible(
 
     lines = []
     for node, other in others:
+        if other.type != endpoint.type:
+            continue  # another type matches nothing anyway
         if endpoint.kind == PUBLISHER:
             found, word = mismatches(endpoint.qos, other.qos), "to"
         else:
