@@ -359,6 +359,14 @@ class Node:
 
         return self.create_publisher(get_message_class(type_name), topic, qos)
 
+    def assert_liveliness(self) -> None:
+        """Assert the liveliness of this node's manual-by-node publishers."""
+        from rosl.node.qos import LivelinessPolicy
+
+        for publisher in self.publishers:
+            if publisher.qos_profile.liveliness is LivelinessPolicy.MANUAL_BY_NODE:
+                publisher.assert_liveliness()
+
     def destroy_publisher(self, publisher: Publisher) -> bool:
         """Remove a publisher (sending what it still holds)."""
         publisher.flush()

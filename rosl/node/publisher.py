@@ -16,7 +16,7 @@ from rosl.bus.header import Kind
 from rosl.bus.wire import Writer
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
-from rosl.node.qos import LivelinessPolicy, duration_ns
+from rosl.node.qos import MANUAL, duration_ns
 
 if TYPE_CHECKING:
     from rosl.idl.messages import Message
@@ -66,7 +66,7 @@ class Publisher:
         self.alive = True  # a manual-by-topic publisher whose lease has not run out
         self._lifespan_ns = duration_ns(qos.lifespan)
         self._lease_ns = duration_ns(qos.liveliness_lease_duration)
-        self._manual = qos.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC
+        self._manual = qos.liveliness in MANUAL
         self._announced_ns = 0  # when assert_liveliness last told the subscriptions
 
     @property

@@ -111,6 +111,7 @@ class LivelinessPolicy(_PolicyEnum):
 
     SYSTEM_DEFAULT = 0
     AUTOMATIC = 1
+    MANUAL_BY_NODE = 2  # deprecated in ROS 2; here as manual-by-topic, asserted by the node
     MANUAL_BY_TOPIC = 3
     UNKNOWN = 4
     BEST_AVAILABLE = 5
@@ -129,6 +130,9 @@ class QoSPolicyKind(enum.IntEnum):
     DEPTH = 1 << 7
     LIVELINESS_LEASE_DURATION = 1 << 8
     AVOID_ROS_NAMESPACE_CONVENTIONS = 1 << 9
+
+
+MANUAL = (LivelinessPolicy.MANUAL_BY_NODE, LivelinessPolicy.MANUAL_BY_TOPIC)
 
 
 def qos_policy_name_from_kind(policy_kind: QoSPolicyKind | int) -> str:

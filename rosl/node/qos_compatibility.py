@@ -6,7 +6,8 @@ A subscription takes nothing from a publisher that offers less than it requests:
 * a volatile publisher and a transient-local subscription (DURABILITY);
 * a publisher's deadline longer than the subscription's, or none where it asks for one
   (DEADLINE);
-* an automatic publisher and a manual-by-topic subscription (LIVELINESS);
+* an automatic publisher and a manual subscription, or manual-by-node and manual-by-topic
+  (LIVELINESS);
 * a lease longer than the subscription's, or none where it asks for one
   (LIVELINESS_LEASE_DURATION).
 
@@ -45,6 +46,13 @@ class Mismatch(NamedTuple):
     reason: str
 
 
+_LIVELINESS = {"AUTOMATIC": 1, "MANUAL_BY_NODE": 2, "MANUAL_BY_TOPIC": 3}  # rmw's order
+
+
+def _word(words: Mapping[str, Any], key: str) -> str:
+    return str(words.get(key, "")).lower().replace("_", "-")
+
+
 def _ns(words: Mapping[str, Any], key: str) -> int:
     try:
         return max(0, int(words.get(key, 0) or 0))
@@ -64,10 +72,12 @@ def mismatches(offered: Mapping[str, Any], requested: Mapping[str, Any]) -> list
         found.append(Mismatch(QoSPolicyKind.DEADLINE,
                               f"publisher deadline ({what}) longer than the subscription's "
                               f"({wanted} ns)"))  # fmt: skip
-    manual = requested.get("liveliness") == "MANUAL_BY_TOPIC"
-    if manual and offered.get("liveliness") == "AUTOMATIC":
+    asked = _LIVELINESS.get(str(requested.get("liveliness")), 0)
+    kept = _LIVELINESS.get(str(offered.get("liveliness")), 0)
+    if asked and kept and kept < asked:
         found.append(Mismatch(QoSPolicyKind.LIVELINESS,
-                              "automatic publisher and manual-by-topic subscription"))  # fmt: skip
+                              f"{_word(offered, 'liveliness')} publisher and "
+                              f"{_word(requested, 'liveliness')} subscription"))  # fmt: skip
     if requested.get("reliability") == "RELIABLE" and offered.get("reliability") == "BEST_EFFORT":
         found.append(Mismatch(QoSPolicyKind.RELIABILITY,
                               "best-effort publisher and reliable subscription"))  # fmt: skip

@@ -10,6 +10,7 @@ optional callback validates the final profile.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.node.clock import Duration
@@ -45,6 +46,14 @@ class InvalidQosOverridesError(NodeError):
     """Overrides that make no profile, or that the options' callback refused."""
 
 
+@dataclass(slots=True)
+class QosCallbackResult:
+    """What a validating callback may return (rclpy's, as SetParametersResult's fields)."""
+
+    successful: bool = False
+    reason: str = ""
+
+
 class QoSOverridingOptions:
     """Which policies of a publisher or subscription parameters may override."""
 
@@ -55,6 +64,7 @@ class QoSOverridingOptions:
         callback: Callable[[QoSProfile], Any] | None = None,
         entity_id: str | None = None,
     ) -> None:
+        """Declare ``policy_kinds`` (``callback`` returns a bool or a QosCallbackResult)."""
         self._policy_kinds = tuple(policy_kinds)
         self._callback = callback
         self._entity_id = entity_id
@@ -123,12 +133,19 @@ def overridden(
         except ParameterAlreadyDeclaredException:
             param = node.get_parameter(name)
         _apply(profile, policy, param.value, name)
-    if options.callback is not None and not options.callback(profile):
-        raise InvalidQosOverridesError(
-            f"Provided QoS overrides for {kind} `{topic}` with id `{options.entity_id}`, "
-            "are not valid"
-        )
+    if options.callback is not None:
+        _validate(options.callback(profile), f"{kind} `{topic}` with id `{options.entity_id}`")
     return profile
+
+
+def _validate(result: Any, what: str) -> None:
+    """Raise unless the callback's result (a bool or a QosCallbackResult) accepts the profile."""
+    successful = getattr(result, "successful", result)
+    if not successful:
+        reason = getattr(result, "reason", "")
+        raise InvalidQosOverridesError(
+            f"Provided QoS overrides for {what}, are not valid{': ' + reason if reason else ''}"
+        )
 
 
 def _value(profile: QoSProfile, policy: QoSPolicyKind) -> str | int | bool:

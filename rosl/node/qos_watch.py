@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION
 from rosl.node.clock import Clock, ClockType
-from rosl.node.qos import LivelinessPolicy, duration_ns, qos_policy_name_from_kind
+from rosl.node.qos import MANUAL, duration_ns, qos_policy_name_from_kind
 from rosl.node.qos_compatibility import Mismatch, mismatches
 from rosl.node.qos_events import (
     IncompatibleTypeInfo,
@@ -151,7 +151,7 @@ class QoSWatch:
     ) -> None:
         """Watch a publisher (its events go to ``callbacks``)."""
         watched = _Watched(publisher, callbacks, PUBLISHER)
-        manual = publisher.qos_profile.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC
+        manual = publisher.qos_profile.liveliness in MANUAL
         self._add(watched, watched.deadline.period_ns, watched.lease_ns if manual else 0)
 
     def add_subscription(
@@ -277,7 +277,7 @@ class QoSWatch:
         callback = watched.callback("deadline")
         if missed and callback is not None:
             callback(QoSOfferedDeadlineMissedInfo(watched.deadline.total, missed))
-        manual = publisher.qos_profile.liveliness is LivelinessPolicy.MANUAL_BY_TOPIC
+        manual = publisher.qos_profile.liveliness in MANUAL
         if not manual or not watched.lease_ns:
             return
         lapsed = now - publisher.last_asserted_ns > watched.lease_ns
@@ -317,7 +317,7 @@ class QoSWatch:
                 continue
             present.add(key)
             if key not in state.peers:
-                manual = endpoint.qos.get("liveliness") == "MANUAL_BY_TOPIC"
+                manual = endpoint.qos.get("liveliness") in ("MANUAL_BY_NODE", "MANUAL_BY_TOPIC")
                 lease = int(endpoint.qos.get("liveliness_lease_duration", 0) or 0)
                 state.peers[key] = _Peer(manual, lease, alive=not manual)
                 if not manual:

@@ -167,7 +167,7 @@ OVERRIDDEN = (
     PROFILE
     + """
 from rclpy.qos import QoSPolicyKind
-from rclpy.qos_overriding_options import QoSOverridingOptions
+from rclpy.qos_overriding_options import QosCallbackResult, QoSOverridingOptions
 from std_msgs.msg import String
 
 rclpy.init()
@@ -175,7 +175,13 @@ node = rclpy.create_node(cfg.get("name", "overridden"))
 
 
 def reasonable(qos):
-    return qos.depth <= 100
+    if cfg.get("bool_callback"):
+        return qos.depth <= 100
+    result = QosCallbackResult()
+    result.successful = qos.depth <= 100
+    if not result.successful:
+        result.reason = "expected a depth of at most 100"
+    return result
 
 
 kinds = [QoSPolicyKind[k] for k in cfg["kinds"]] if "kinds" in cfg else None
@@ -194,3 +200,37 @@ say("ready")
 rclpy.spin(node)
 """
 )
+
+ONE_PROCESS = """
+import rclpy
+from rclpy.duration import Duration
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.logging import get_logger
+from rclpy.node import Node
+from rclpy.qos import QoSLivelinessPolicy, QoSProfile
+from rclpy.qos_event import PublisherEventCallbacks, SubscriptionEventCallbacks
+from std_msgs.msg import String
+
+rclpy.init()
+qos = QoSProfile(
+    depth=10,
+    liveliness=QoSLivelinessPolicy.RMW_QOS_POLICY_LIVELINESS_MANUAL_BY_NODE,
+    liveliness_lease_duration=Duration(seconds=1.0),
+)
+listener = Node("one_listener")
+listener.create_subscription(
+    String, "one_chatter", lambda m: None, qos,
+    event_callbacks=SubscriptionEventCallbacks(liveliness=lambda e: print(
+        f"changed alive={e.alive_count} not_alive={e.not_alive_count}", flush=True)))
+talker = Node("one_talker")
+talker.create_publisher(
+    String, "one_chatter", qos,
+    event_callbacks=PublisherEventCallbacks(liveliness=lambda e: print(
+        f"lost total={e.total_count}", flush=True)))
+asserter = talker.create_timer(0.2, talker.assert_liveliness)
+listener.create_timer(3.0, asserter.cancel)
+executor = SingleThreadedExecutor()
+executor.add_node(listener)
+executor.add_node(talker)
+executor.spin()
+"""

@@ -13,7 +13,8 @@ import time
 
 import pytest
 
-from tests.node.qos_programs import LISTENER, TALKER, start
+from tests.conftest import wait_until
+from tests.node.qos_programs import LISTENER, ONE_PROCESS, RUN_AS_RCLPY, TALKER, start, write
 
 BOUND = 30.0  # seconds: only a broken implementation takes this long
 
@@ -242,3 +243,12 @@ def test_messages_past_their_lifespan_when_taken_are_not_delivered(spawn, tmp_pa
     assert gaps(_heard(listener, "short_lived"))  # the stale ones were dropped
     assert not gaps(_heard(listener, "lasting"))  # the same wait loses nothing without lifespan
     assert listener.count(r"^message lost") == 0
+
+
+def test_manual_by_node_liveliness_in_one_process_as_the_liveliness_demo_runs(spawn, tmp_path):
+    child = spawn(RUN_AS_RCLPY, write(tmp_path, ONE_PROCESS, "one_process"))
+
+    child.expect(r"^changed alive=1 not_alive=0$", timeout=BOUND)  # node.assert_liveliness()
+    # the asserting timer was cancelled: both sides are told, in either order
+    assert wait_until(lambda: child.count(r"^lost total=1$") == 1, BOUND), child.text
+    assert wait_until(lambda: child.count(r"^changed alive=0 not_alive=1$") == 1, BOUND)

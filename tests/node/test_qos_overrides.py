@@ -84,15 +84,19 @@ def test_a_bad_override_or_a_refused_profile_names_the_parameter(spawn, tmp_path
         )
     )
 
-    deep = spawn(run, script, "--ros-args", "-p",
-                 "qos_overrides./qos_chatter.publisher.depth:=5000",
-                 "--", '{"name": "overridden"}')  # fmt: skip
-    _, err = deep.finish(timeout=BOUND)
-    assert deep.returncode != 0
-    assert (
-        err.strip()
-        .splitlines()[-1]
-        .endswith(
-            "Provided QoS overrides for publisher `/qos_chatter` with id `None`, are not valid"
+    for settings, reason in (
+        ('{"name": "overridden"}', ": expected a depth of at most 100"),
+        ('{"name": "overridden", "bool_callback": true}', ""),
+    ):
+        deep = spawn(run, script, "--ros-args", "-p",
+                     "qos_overrides./qos_chatter.publisher.depth:=5000", "--", settings)  # fmt: skip
+        _, err = deep.finish(timeout=BOUND)
+        assert deep.returncode != 0
+        assert (
+            err.strip()
+            .splitlines()[-1]
+            .endswith(
+                "Provided QoS overrides for publisher `/qos_chatter` with id `None`, are not valid"
+                + reason
+            )
         )
-    )
