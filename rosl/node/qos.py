@@ -208,7 +208,7 @@ class QoSProfile:
             "reliability": _in_force(self.reliability, ReliabilityPolicy.RELIABLE).name,
             "durability": _in_force(self.durability, DurabilityPolicy.VOLATILE).name,
             "history": _in_force(self.history, HistoryPolicy.KEEP_LAST).name,
-            "depth": self.depth,
+            "depth": self.depth if self.history.name not in _VAGUE else max(1, self.depth),
             "liveliness": _in_force(self.liveliness, LivelinessPolicy.AUTOMATIC).name,
             "deadline": duration_ns(self.deadline),
             "lifespan": duration_ns(self.lifespan),
@@ -221,9 +221,12 @@ class QoSProfile:
         return self.durability is DurabilityPolicy.TRANSIENT_LOCAL
 
 
+_VAGUE = ("SYSTEM_DEFAULT", "UNKNOWN")
+
+
 def _in_force(policy: _PolicyEnum, default: _PolicyEnum) -> _PolicyEnum:
     """What a ROS 2 middleware uses for a ``SYSTEM_DEFAULT``/``UNKNOWN`` policy."""
-    return default if policy.name in ("SYSTEM_DEFAULT", "UNKNOWN") else policy
+    return default if policy.name in _VAGUE else policy
 
 
 def _profile(**kwargs: Any) -> QoSProfile:
