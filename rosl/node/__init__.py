@@ -1,7 +1,7 @@
 """Nodes in the rclpy style, and everything a node owns.
 
 Node, publishers, subscriptions, timers, services, clients, parameters, clock and sim time,
-logging, names and ``--ros-args``.
+logging, names and ``--ros-args``, and QoS: profiles, compatibility, events and overrides.
 
 Imports ``rosl.graph``, ``rosl.bus`` and ``rosl.idl``; never the CLI, launch, bag or sim.
 """
