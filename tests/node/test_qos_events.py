@@ -30,10 +30,12 @@ INCOMPATIBLE = [
 def test_an_incompatible_pair_exchanges_nothing_and_both_sides_are_told(
     spawn, tmp_path, policy, offered, requested
 ):
-    talker = start(spawn, tmp_path, TALKER, "talker", offered)
     told = start(spawn, tmp_path, LISTENER, "told", requested)
     warned = start(spawn, tmp_path, LISTENER, "warned", {**requested, "callbacks": False})
     control = start(spawn, tmp_path, LISTENER, "control", {"reliability": "BEST_EFFORT"})
+    for listener in (told, warned, control):  # they hear of the publisher before it publishes
+        listener.expect(r"^ready$", timeout=BOUND)
+    talker = start(spawn, tmp_path, TALKER, "talker", offered)
 
     talker.expect(rf"^offered incompatible total=\d+ change=\d+ policy={policy}$", timeout=BOUND)
     told.expect(rf"^requested incompatible total=1 change=1 policy={policy}$", timeout=BOUND)
