@@ -202,10 +202,15 @@ class QoSProfile:
         if self.depth < 0:
             raise InvalidQoSProfileException("QoSProfile depth must be >= 0")
 
-    def words(self) -> dict[str, Any]:
-        """The profile as plain words, for discovery and ``topic info -v`` (durations in ns)."""
+    def words(self, subscription: bool = False) -> dict[str, Any]:
+        """The profile as plain words, for discovery and ``topic info -v`` (durations in ns).
+
+        ``SYSTEM_DEFAULT`` policies become what a DDS middleware uses: a reliable publisher, a
+        best-effort subscription (``subscription=True``), volatile, keep-last, automatic.
+        """
+        reliable = ReliabilityPolicy.BEST_EFFORT if subscription else ReliabilityPolicy.RELIABLE
         return {
-            "reliability": _in_force(self.reliability, ReliabilityPolicy.RELIABLE).name,
+            "reliability": _in_force(self.reliability, reliable).name,
             "durability": _in_force(self.durability, DurabilityPolicy.VOLATILE).name,
             "history": _in_force(self.history, HistoryPolicy.KEEP_LAST).name,
             "depth": self.depth if self.history.name not in _VAGUE else max(1, self.depth),

@@ -106,7 +106,7 @@ def qos_check_compatible(
     Returns:
         The verdict and the reason (empty when OK).
     """
-    found = mismatches(publisher_qos.words(), subscription_qos.words())
+    found = mismatches(publisher_qos.words(), subscription_qos.words(subscription=True))
     if found:
         return QoSCompatibility.ERROR, "; ".join(m.reason for m in found)
     vague = [

@@ -104,7 +104,7 @@ class _Watched:
         self.entity = entity
         self.callbacks = callbacks
         self.kind = kind  # PUBLISHER or SUBSCRIPTION
-        self.words = entity.qos_profile.words()
+        self.words = entity.qos_profile.words(kind == SUBSCRIPTION)
         self.incompatible = Incompatible()
         self.wrong_types: set[tuple[int, int]] = set()  # endpoints of another type, told
         self.wrong_type_total = 0

@@ -118,7 +118,7 @@ class Subscription(Queued):
         self.undecodable = 0
         self.incompatible = 0  # messages of publishers whose QoS does not match (dropped)
         self.expired = 0  # messages older than their publisher's lifespan (dropped)
-        self._words = qos.words()
+        self._words = qos.words(subscription=True)
         self.last_arrival_ns: int | None = None  # for the deadline (see qos_watch)
         self.peer_seen: dict[tuple[int, int], int] | None = None  # per publisher, when tracked
         self._warned: set[int] = set()
@@ -282,7 +282,7 @@ class Subscription(Queued):
     def record(self) -> EndpointRecord:
         """This subscription as discovery announces it."""
         return EndpointRecord(
-            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
+            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self._words,
             {"received": self.received, "lost": self.lost, "dropped": self.dropped,
              "mismatched": self.mismatched, "incompatible": self.incompatible,
              "expired": self.expired},

@@ -104,3 +104,15 @@ def test_qos_check_compatible_answers_as_rclpy():
     assert qos_check_compatible(QoSProfile(depth=1), best_effort) == (QoSCompatibility.OK, "")
     verdict, _ = qos_check_compatible(qos_profile_system_default, QoSProfile(depth=1))
     assert verdict is QoSCompatibility.WARNING
+
+
+def test_a_system_default_subscription_hears_a_best_effort_publisher_as_with_dds():
+    """DDS readers default to best effort: the seed's obstacle avoidance reads a sensor topic."""
+    publisher = qos_profile_sensor_data.words()
+    subscription = qos_profile_system_default.words(subscription=True)
+
+    assert subscription["reliability"] == "BEST_EFFORT"
+    assert mismatches(publisher, subscription) == []
+    assert qos_profile_system_default.words()["reliability"] == "RELIABLE"  # a publisher's
+    verdict, _ = qos_check_compatible(qos_profile_sensor_data, qos_profile_system_default)
+    assert verdict is not QoSCompatibility.ERROR
