@@ -133,8 +133,8 @@ class Publisher:
         """
         now = time.time_ns()
         self.last_asserted_ns, self.alive = now, True
-        if now - self._announced_ns < max(self._lease_ns // 4, 50_000_000):
-            return
+        if not self._manual or now - self._announced_ns < max(self._lease_ns // 4, 50_000_000):
+            return  # automatic: discovery asserts it
         self._announced_ns = now
         participant = self.node.participant
         participant.discovery.send(
