@@ -90,6 +90,15 @@ def test_topic_info_verbose_shows_the_durations_and_flags_an_incompatible_pair(
     )
     assert "Incompatible QoS: no messages from /talker (RELIABILITY:" in info.stdout
 
+    doctor = subprocess.run(
+        [sys.executable, "-m", "rosl", "doctor"],
+        capture_output=True, text=True, timeout=BOUND, check=False,
+    )  # fmt: skip
+    assert (
+        "       UserWarning: Incompatible QoS on /qos_chatter: /listener hears nothing from "
+        "/talker (RELIABILITY)." in doctor.stdout
+    ), doctor.stdout + doctor.stderr
+
 
 def test_deadlines_missed_are_told_on_both_sides_once_messages_stop(spawn, tmp_path):
     deadline = {"deadline": 0.5}
