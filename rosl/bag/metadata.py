@@ -92,7 +92,12 @@ class FileInfo:
 
 
 def qos_entry(words: Mapping[str, Any]) -> dict[str, Any]:
-    """A QoS profile in version 9's words, from discovery's QoS words."""
+    """A QoS profile in version 9's words, from discovery's QoS words (durations in ns)."""
+    durations = {
+        key: {"sec": ns // 1_000_000_000, "nsec": ns % 1_000_000_000}
+        for key in ("deadline", "lifespan", "liveliness_lease_duration")
+        if isinstance(ns := words.get(key), int) and ns > 0
+    }
     return normalize_profile(
         {
             "history": words.get("history", "KEEP_LAST"),
@@ -100,6 +105,7 @@ def qos_entry(words: Mapping[str, Any]) -> dict[str, Any]:
             "reliability": words.get("reliability", "RELIABLE"),
             "durability": words.get("durability", "VOLATILE"),
             "liveliness": words.get("liveliness", "AUTOMATIC"),
+            **durations,
         }
     )
 

@@ -33,6 +33,8 @@ class GraphCache:
         self._changed = threading.Condition()
         self.generation = 0  # increments on every change
         self.refused = 0  # announcements of new processes refused while the table was full
+        # called (with no lock held) after each change; one that returns False is dropped
+        self.listeners: list[Callable[[], bool]] = []
 
     # --- updates -----------------------------------------------------------------------------
 
@@ -47,13 +49,18 @@ class GraphCache:
             changed = old is None or old.nodes != record.nodes
             if changed:
                 self._bump()
-            return changed
+        if changed:
+            self._tell()
+        return changed
 
     def remove(self, sender: int) -> None:
         """Forget a process (it said goodbye)."""
         with self._changed:
-            if self._processes.pop(sender, None) is not None:
+            gone = self._processes.pop(sender, None) is not None
+            if gone:
                 self._bump()
+        if gone:
+            self._tell()
 
     def expire(self, now: float | None = None) -> list[ProcessRecord]:
         """Forget processes whose lease ran out; return them."""
@@ -64,11 +71,18 @@ class GraphCache:
                 del self._processes[process.sender]
             if gone:
                 self._bump()
-            return gone
+        if gone:
+            self._tell()
+        return gone
 
     def _bump(self) -> None:
         self.generation += 1
         self._changed.notify_all()
+
+    def _tell(self) -> None:
+        for listener in list(self.listeners):
+            if not listener():
+                self.listeners.remove(listener)
 
     def wait_for(self, predicate: Callable[[], bool], timeout: float | None) -> bool:
         """Block until ``predicate()`` holds (re-checked on every change) or the timeout."""

@@ -213,6 +213,25 @@ def _nodes(result: Diagnosis, session: Session, domain: int | None) -> CheckResu
     return CheckResult("node", True, f"{len(names)} nodes, every name unique")
 
 
+def _incompatible_qos(graph: GraphCache, topic: str) -> list[str]:
+    """A warning per publisher and subscription of one type that QoS keeps apart."""
+    from rosl.node.qos_compatibility import mismatches
+
+    subscriptions = graph.endpoints(SUBSCRIPTION, topic)
+    found = []
+    for pub_node, publisher in graph.endpoints(PUBLISHER, topic):
+        for sub_node, subscription in subscriptions:
+            if publisher.type != subscription.type:
+                continue
+            kinds = [m.kind.name for m in mismatches(publisher.qos, subscription.qos)]
+            if kinds:
+                found.append(
+                    f"Incompatible QoS on {topic}: {sub_node.fqn} hears nothing from "
+                    f"{pub_node.fqn} ({', '.join(kinds)})."
+                )
+    return found
+
+
 def _topics(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
     del session, domain
     graph = result.graph
@@ -235,6 +254,7 @@ def _topics(result: Diagnosis, session: Session, domain: int | None) -> CheckRes
             warnings.append(f"Publisher without subscriber detected on {name}.")
         elif subscribers and not publishers:
             warnings.append(f"Subscriber without publisher detected on {name}.")
+        warnings += _incompatible_qos(graph, name)
     if mixed:
         return CheckResult("topic", False, "topic type mismatch", tuple(warnings), mixed)
     return CheckResult("topic", True, f"{len(topics)} topics, one type each", tuple(warnings))

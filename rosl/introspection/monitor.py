@@ -133,8 +133,10 @@ def delay(session: Session, topic: str, window: int) -> Iterator[str]:
         if stamp is not None:
             delays.add(info["received_timestamp"], stamp)
 
+    from rosl.node.qos import qos_profile_sensor_data
+
     node = session.node()
-    node.create_subscription(msg_type, topic, on_message, 10)
+    node.create_subscription(msg_type, topic, on_message, qos_profile_sensor_data)
     executor = rosl.SingleThreadedExecutor()
     executor.add_node(node)
     last = time.monotonic()

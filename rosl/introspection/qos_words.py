@@ -89,4 +89,5 @@ def _concrete(profile: QoSProfile) -> QoSProfile:
         if profile.durability in vague_durability
         else profile.durability,
         history=HistoryPolicy.KEEP_LAST if profile.history in vague_history else profile.history,
+        depth=profile.depth or 10 if profile.history in vague_history else profile.depth,
     )

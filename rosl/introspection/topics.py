@@ -74,14 +74,43 @@ def topic_info(
     subs = sorted_endpoints(graph.endpoints(SUBSCRIPTION, topic))
     lines.append(f"Publisher count: {len(pubs)}{end}")
     if verbose:
-        lines += [_endpoint_block(node, e, stats) + "\n" for node, e in pubs]
+        lines += [_endpoint_block(node, e, stats, subs) + "\n" for node, e in pubs]
     lines.append(f"Subscription count: {len(subs)}{end}")
     if verbose:
-        lines += [_endpoint_block(node, e, stats) + "\n" for node, e in subs]
+        lines += [_endpoint_block(node, e, stats, pubs) + "\n" for node, e in subs]
     return lines
 
 
-def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord, stats: bool) -> str:
+def _duration(ns: object) -> str:
+    return f"{ns} nanoseconds" if isinstance(ns, int) and ns > 0 else "Infinite"
+
+
+def _incompatible(
+    endpoint: EndpointRecord, others: list[tuple[NodeRecord, EndpointRecord]]
+) -> list[str]:
+    """A line per endpoint on the other side that this one exchanges nothing with (QoS)."""
+    from rosl.node.qos_compatibility import mismatches
+
+    lines = []
+    for node, other in others:
+        if other.type != endpoint.type:
+            continue  # another type matches nothing anyway
+        if endpoint.kind == PUBLISHER:
+            found, word = mismatches(endpoint.qos, other.qos), "to"
+        else:
+            found, word = mismatches(other.qos, endpoint.qos), "from"
+        if found:
+            reasons = "; ".join(f"{m.kind.name}: {m.reason}" for m in found)
+            lines.append(f"Incompatible QoS: no messages {word} {node.fqn} ({reasons})")
+    return lines
+
+
+def _endpoint_block(
+    node: NodeRecord,
+    endpoint: EndpointRecord,
+    stats: bool,
+    others: list[tuple[NodeRecord, EndpointRecord]],
+) -> str:
     qos = endpoint.qos
     history = qos.get("history", "KEEP_LAST")
     depth = f"{history} ({qos.get('depth', 0)})" if history == "KEEP_LAST" else history
@@ -95,10 +124,11 @@ def _endpoint_block(node: NodeRecord, endpoint: EndpointRecord, stats: bool) -> 
         f"  Reliability: {qos.get('reliability', 'UNKNOWN')}",
         f"  History (Depth): {depth}",
         f"  Durability: {qos.get('durability', 'UNKNOWN')}",
-        "  Lifespan: Infinite",
-        "  Deadline: Infinite",
+        f"  Lifespan: {_duration(qos.get('lifespan'))}",
+        f"  Deadline: {_duration(qos.get('deadline'))}",
         f"  Liveliness: {qos.get('liveliness', 'AUTOMATIC')}",
-        "  Liveliness lease duration: Infinite",
+        f"  Liveliness lease duration: {_duration(qos.get('liveliness_lease_duration'))}",
+        *_incompatible(endpoint, others),
     ]
     if not stats:
         return "\n".join(lines)

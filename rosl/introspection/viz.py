@@ -283,12 +283,13 @@ def subscribe_drawable(
 ) -> None:
     """Subscribe ``node`` to every drawable topic with a publisher not in ``subscribed``.
 
-    A transient-local publisher gets a transient-local subscription (its history arrives);
+    A transient-local publisher gets a transient-local subscription (its history arrives), a
+    best-effort one a best-effort subscription (a reliable one would match nothing);
     ``callback(topic, type)`` makes each subscription's callback; ``subscribed`` grows.
     """
     from rosl.graph.records import PUBLISHER
     from rosl.idl.registry import get_message_class
-    from rosl.node.qos import DurabilityPolicy, QoSProfile
+    from rosl.node.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 
     for _, endpoint in graph.endpoints(PUBLISHER):
         if endpoint.type not in KINDS or endpoint.name in subscribed:
@@ -296,9 +297,12 @@ def subscribe_drawable(
         subscribed.add(endpoint.name)
         latched = str(endpoint.qos.get("durability", "")).upper() == "TRANSIENT_LOCAL"
         durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+        best_effort = str(endpoint.qos.get("reliability", "")).upper() == "BEST_EFFORT"
+        reliability = ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE
+        qos = QoSProfile(depth=depth, durability=durability, reliability=reliability)
         node.create_subscription(
-            get_message_class(endpoint.type), endpoint.name,
-            callback(endpoint.name, endpoint.type), QoSProfile(depth=depth, durability=durability),
+            get_message_class(endpoint.type), endpoint.name, callback(endpoint.name, endpoint.type),
+            qos,
         )  # fmt: skip
 
 

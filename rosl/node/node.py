@@ -41,6 +41,8 @@ if TYPE_CHECKING:
     from rosl.node.guard_condition import GuardCondition
     from rosl.node.participant import Participant
     from rosl.node.publisher import Publisher
+    from rosl.node.qos_overrides import QoSOverridingOptions
+    from rosl.node.qos_watch import QoSWatch
     from rosl.node.service import Service
     from rosl.node.subscription import Subscription
     from rosl.node.timer import Rate, Timer
@@ -98,6 +100,7 @@ class Node:
             self._name, overrides, self._parameter_event, allow_undeclared_parameters
         )
         self._events: Publisher | None = None
+        self._qos_watch: QoSWatch | None = None  # QoS events (rosl/node/qos_watch.py)
         self.index = self.participant.add_node(self.record)
         self.context.nodes.append(self)
         if enable_rosout and global_args.enable_rosout:
@@ -169,6 +172,7 @@ class Node:
         *,
         callback_group: Any = None,
         event_callbacks: Any = None,
+        qos_overriding_options: QoSOverridingOptions | None = None,
         coalesce: bool | None = None,
         publisher_class: type[Publisher] | None = None,
     ) -> Publisher:
@@ -179,15 +183,17 @@ class Node:
         (a subclass of Publisher, as rclpy.lifecycle's LifecyclePublisher) builds the publisher.
         """
         from rosl.node.publisher import Publisher
+        from rosl.node.qos_overrides import overridden
+        from rosl.node.qos_watch import watch
 
-        del callback_group, event_callbacks
+        del callback_group
+        name = self.resolve_topic_name(topic)
+        profile = as_profile(qos_profile)
+        profile = overridden(self, "publisher", name, profile, qos_overriding_options)
         publisher = (publisher_class or Publisher)(
-            self,
-            _message_class(msg_type),
-            self.resolve_topic_name(topic),
-            as_profile(qos_profile),
-            coalesce,
+            self, _message_class(msg_type), name, profile, coalesce
         )
+        watch(self).add_publisher(publisher, event_callbacks)
         self.publishers.append(publisher)
         self.participant.discovery.changed()
         return publisher
@@ -201,16 +207,19 @@ class Node:
         *,
         callback_group: CallbackGroup | None = None,
         event_callbacks: Any = None,
+        qos_overriding_options: QoSOverridingOptions | None = None,
         raw: bool = False,
     ) -> Subscription:
         """Call ``callback(msg)`` for each message on ``topic``."""
+        from rosl.node.qos_overrides import overridden
+        from rosl.node.qos_watch import watch
         from rosl.node.subscription import Subscription
 
-        del event_callbacks
-        subscription = Subscription(
-            self, _message_class(msg_type), self.resolve_topic_name(topic), callback,
-            as_profile(qos_profile), raw,
-        )  # fmt: skip
+        name = self.resolve_topic_name(topic)
+        profile = as_profile(qos_profile)
+        profile = overridden(self, "subscription", name, profile, qos_overriding_options)
+        subscription = Subscription(self, _message_class(msg_type), name, callback, profile, raw)
+        watch(self).add_subscription(subscription, event_callbacks)
         self._join(subscription, callback_group)
         self.subscriptions.append(subscription)
         self.participant.discovery.changed()
@@ -353,6 +362,14 @@ class Node:
         from rosl.idl.registry import get_message_class
 
         return self.create_publisher(get_message_class(type_name), topic, qos)
+
+    def assert_liveliness(self) -> None:
+        """Assert the liveliness of this node's manual-by-node publishers."""
+        from rosl.node.qos import LivelinessPolicy
+
+        for publisher in self.publishers:
+            if publisher.qos_profile.liveliness is LivelinessPolicy.MANUAL_BY_NODE:
+                publisher.assert_liveliness()
 
     def destroy_publisher(self, publisher: Publisher) -> bool:
         """Remove a publisher (sending what it still holds); False if it is not this node's."""

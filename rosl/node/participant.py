@@ -29,6 +29,9 @@ if TYPE_CHECKING:
     from rosl.node.lockstep import Answerer
 
 
+MAX_ASSERTING = 4096  # publishers whose manual liveliness assertions are remembered
+
+
 class Handler(Protocol):
     """Something that takes deliveries for one topic or service hash."""
 
@@ -71,6 +74,9 @@ class Participant:
         self.discovery = Discovery(self.transport, self.sender, self._describe)
         self.discovery.handlers["replay"] = self._on_replay_request
         self.discovery.handlers["typedef_request"] = self._on_typedef_request
+        # manual-by-topic liveliness: (process, endpoint) -> when it last asserted (ns)
+        self.asserted: dict[tuple[int, int], int] = {}
+        self.discovery.handlers["liveliness"] = self._on_liveliness
         self.discovery.on_gone.append(self.reader.forget)  # its streams' state is retired
         self.closed = False
         self.discovery.start()
@@ -122,6 +128,13 @@ class Participant:
             publishers = list(self._replayers.get(topic, ()))
         for publisher in publishers:
             publisher.replay(target)
+
+    def _on_liveliness(self, message: dict[str, object]) -> None:
+        # runs on the discovery thread: a publisher asserted its liveliness (see qos_watch)
+        key = (int(str(message["sender"]), 16), int(cast("int", message["endpoint"])))
+        if len(self.asserted) >= MAX_ASSERTING and key not in self.asserted:
+            self.asserted.clear()  # strangers' ids must not grow it; live ones assert again
+        self.asserted[key] = time.time_ns()
 
     def _on_typedef_request(self, message: dict[str, object]) -> None:
         # runs on the discovery thread: someone (a recorder) needs a type this process uses

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import collections
 import os
+import time
 from typing import TYPE_CHECKING
 
 from rosl.bus.header import Kind
 from rosl.bus.wire import Writer
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
+from rosl.node.qos import MANUAL, duration_ns
 
 if TYPE_CHECKING:
     from rosl.idl.messages import Message
@@ -58,6 +60,14 @@ class Publisher:
         self.destroyed = False
         if self._history is not None:
             participant.add_replayer(topic, self)
+        # QoS events (see qos_watch): deadline, lifespan, manual-by-topic liveliness
+        self.last_published_ns: int | None = None
+        self.last_asserted_ns = time.time_ns()
+        self.alive = True  # a manual-by-topic publisher whose lease has not run out
+        self._lifespan_ns = duration_ns(qos.lifespan)
+        self._lease_ns = duration_ns(qos.liveliness_lease_duration)
+        self._manual = qos.liveliness in MANUAL
+        self._announced_ns = 0  # when assert_liveliness last told the subscriptions
 
     @property
     def topic_name(self) -> str:
@@ -75,14 +85,20 @@ class Publisher:
                 raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
             data = self._store.serialize_view(msg)  # no copy into bytes: any buffer sends
         seq = self._writer.send(data)
+        now = self.last_published_ns = time.time_ns()
+        if self._manual:
+            self.last_asserted_ns, self.alive = now, True
         if self._history is not None:
-            self._history.append((seq, self._writer.sent, data))
+            self._history.append((seq, now, data))
 
     def replay(self, target: tuple[int, int]) -> None:
         """Send the kept history to one late subscriber (transient local)."""
         if self._history is None or self.destroyed:
             return
-        for seq, _, data in list(self._history):
+        oldest = time.time_ns() - self._lifespan_ns if self._lifespan_ns else 0
+        for seq, stamp, data in list(self._history):
+            if stamp < oldest:
+                continue  # past its lifespan: a late subscriber never sees it
             self._writer.send(data, kind=Kind.REPLAY, address=(*target, 0), seq=seq)
 
     def get_subscription_count(self) -> int:
@@ -111,4 +127,17 @@ class Publisher:
         self.node.destroy_publisher(self)
 
     def assert_liveliness(self) -> None:
-        """Liveliness is asserted by discovery; nothing to do."""
+        """Tell matched subscriptions this publisher is alive (manual-by-topic liveliness).
+
+        Automatic liveliness is asserted by discovery; calls closer together than a quarter
+        of the lease (or 50 ms) send nothing more.
+        """
+        now = time.time_ns()
+        self.last_asserted_ns, self.alive = now, True
+        if not self._manual or now - self._announced_ns < max(self._lease_ns // 4, 50_000_000):
+            return  # automatic: discovery asserts it
+        self._announced_ns = now
+        participant = self.node.participant
+        participant.discovery.send(
+            {"op": "liveliness", "sender": f"{participant.sender:016x}", "endpoint": self.endpoint}
+        )

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import time
 from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -24,6 +25,7 @@ from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
 from rosl.node.callback_groups import Queued
 from rosl.node.qos import HistoryPolicy
+from rosl.node.qos_compatibility import compatible
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -48,6 +50,10 @@ def queue_depth(qos: QoSProfile) -> int:
     return max(1, qos.depth)
 
 
+def _int(value: object) -> int:
+    return value if isinstance(value, int) and value > 0 else 0
+
+
 def _wants_info(callback: Callable[..., Any]) -> bool:
     try:
         params = [
@@ -66,6 +72,8 @@ class _Peer:
 
     agrees: bool | None  # same definition of the type; None while discovery has not told
     generation: int  # the graph's generation when that was decided
+    takes: bool = True  # its QoS matches this subscription's (see qos_compatibility)
+    lifespan_ns: int = 0  # its messages are not delivered once older than this (0: never)
 
 
 class Subscription(Queued):
@@ -108,6 +116,11 @@ class Subscription(Queued):
         self.dropped = 0  # deliveries pushed out of a full queue (the callback fell behind)
         self.mismatched = 0
         self.undecodable = 0
+        self.incompatible = 0  # messages of publishers whose QoS does not match (dropped)
+        self.expired = 0  # messages older than their publisher's lifespan (dropped)
+        self._words = qos.words(subscription=True)
+        self.last_arrival_ns: int | None = None  # for the deadline (see qos_watch)
+        self.peer_seen: dict[tuple[int, int], int] | None = None  # per publisher, when tracked
         self._warned: set[int] = set()
         self.destroyed = False
         participant.listen(self._topic_hash, self)
@@ -139,10 +152,20 @@ class Subscription(Queued):
                 return  # history asked for by another subscription
         elif kind != _DATA:
             return
+        self.last_arrival_ns = delivery.received
+        if self.peer_seen is not None:
+            self._seen(delivery)
         queue = self._queue
         if len(queue) == queue.maxlen:
             self.dropped += 1
         queue.append(delivery)
+
+    def _seen(self, delivery: Delivery) -> None:
+        seen = self.peer_seen
+        if seen is not None:
+            if len(seen) >= MAX_PEERS:
+                seen.clear()
+            seen[(delivery.sender, delivery.endpoint)] = delivery.received
 
     def _take(self) -> Callable[[], Any] | None:
         """Take the oldest queued delivery: the call of the callback with its message."""
@@ -171,6 +194,12 @@ class Subscription(Queued):
             peer = self._peers[key] = self._meet(delivery)
         if peer.agrees is False:
             self.mismatched += 1
+            return None
+        if not peer.takes:
+            self.incompatible += 1
+            return None
+        if peer.lifespan_ns and time.time_ns() - delivery.stamp > peer.lifespan_ns:
+            self.expired += 1
             return None
         if delivery.kind == _DATA:
             if self.qos_profile.keeps_history:
@@ -242,7 +271,8 @@ class Subscription(Queued):
                 f".msg files define it, but {node.fqn} publishes another definition of it "
                 "(one of the two .msg files changed); dropped without decoding"
             )
-        return _Peer(agrees, generation)
+        qos = endpoint.qos
+        return _Peer(agrees, generation, compatible(qos, self._words), _int(qos.get("lifespan")))
 
     @property
     def lost(self) -> int:
@@ -252,9 +282,10 @@ class Subscription(Queued):
     def record(self) -> EndpointRecord:
         """This subscription as discovery announces it."""
         return EndpointRecord(
-            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self.qos_profile.words(),
+            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self._words,
             {"received": self.received, "lost": self.lost, "dropped": self.dropped,
-             "mismatched": self.mismatched},
+             "mismatched": self.mismatched, "incompatible": self.incompatible,
+             "expired": self.expired},
             self.digest,
         )  # fmt: skip
 
