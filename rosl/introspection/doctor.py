@@ -177,7 +177,7 @@ def _packages(result: Diagnosis, session: Session, domain: int | None) -> CheckR
 def _interfaces(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
     from rosl.idl import registry
     from rosl.idl.errors import InterfaceError
-    from rosl.idl.parser import ActionSpec, ServiceSpec
+    from rosl.idl.parser import ActionSpec, MessageSpec, ServiceSpec
 
     del session, domain
     checked, errors = 0, []
@@ -187,6 +187,7 @@ def _interfaces(result: Diagnosis, session: Session, domain: int | None) -> Chec
                 checked += 1
                 try:
                     spec = registry.load_spec(f"{package}/{kind}/{name}")
+                    halves: tuple[MessageSpec, ...]
                     if isinstance(spec, ActionSpec):
                         halves = spec.parts
                     elif isinstance(spec, ServiceSpec):

@@ -35,9 +35,9 @@ __all__ = [
 
 
 _SUBMODULES = frozenset(
-    ("callback_groups", "client", "clock", "context", "duration", "exceptions", "executors",
-     "guard_condition", "logging", "node", "parameter", "publisher", "qos", "service", "signals",
-     "subscription", "task", "time", "timer", "utilities", "waitable")
+    ("action", "callback_groups", "client", "clock", "context", "duration", "exceptions",
+     "executors", "guard_condition", "logging", "node", "parameter", "publisher", "qos", "service",
+     "signals", "subscription", "task", "time", "timer", "utilities", "waitable")
 )  # fmt: skip
 
 
