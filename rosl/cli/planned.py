@@ -1,7 +1,7 @@
 """ROS 2 commands rosl does not have yet: each answers in one line and exits 1.
 
-``rosl action`` and ``rosl lifecycle`` come with actions and lifecycle nodes in a later
-version; ``rosl component`` loads C++ components into a container, which pure Python cannot.
+``rosl lifecycle`` comes with lifecycle nodes in a later version; ``rosl component`` loads C++
+components into a container, which pure Python cannot.
 """
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ from rosl.errors import RoslError
 
 LATER = "{what} are not in rosl yet; they come in a later version"
 WHY_NOT = {
-    "action": LATER.format(what="actions"),
     "lifecycle": LATER.format(what="lifecycle nodes"),
     "component": "components are not in rosl: they are C++ libraries a container process loads",
 }
@@ -36,6 +35,5 @@ def _planned(name: str) -> click.Command:
     return planned
 
 
-action = _planned("action")
 lifecycle = _planned("lifecycle")
 component = _planned("component")
