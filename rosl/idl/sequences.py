@@ -4,7 +4,8 @@ rclpy holds a numeric ``T[]`` / ``T[<=N]`` field as an ``array.array``, so ROS 2
 ``feedback.sequence.append(x)``. rosl keeps numpy arrays (fast CDR, numpy maths); the array a
 message holds is a :class:`SequenceArray` that remembers its message (weakly), and ``append``,
 ``extend``, ``insert`` and ``pop`` replace the message's field with the grown or shrunk array
-(checked like any assignment: dtype, range, bound).
+(checked like any assignment: dtype, range, bound). Iterating or indexing it gives Python
+numbers, and it prints as ``array('i', [0, 1])``, as rclpy's fields do.
 """
 
 from __future__ import annotations
@@ -20,6 +21,11 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
 
 
+# numpy's type characters -> array.array's typecodes (what rclpy prints)
+_TYPECODES = {"b": "b", "B": "B", "h": "h", "H": "H", "i": "i", "I": "I", "l": "q", "L": "Q",
+              "q": "q", "Q": "Q", "f": "f", "d": "d", "?": "?"}  # fmt: skip
+
+
 class SequenceArray(np.ndarray):
     """A numpy array held by a message's sequence field; list-like growth changes that field."""
 
@@ -27,6 +33,24 @@ class SequenceArray(np.ndarray):
 
     def __array_finalize__(self, obj: Any) -> None:
         self._owner = None  # a slice or a result is not the message's field
+
+    def __array_wrap__(self, array: Any, context: Any = None, return_scalar: bool = False) -> Any:
+        result = array.view(np.ndarray)  # maths on a field gives plain arrays and numbers
+        return result[()] if return_scalar or result.ndim == 0 else result
+
+    def __iter__(self) -> Any:
+        return iter(self.tolist())  # Python numbers, as array.array yields
+
+    def __getitem__(self, key: Any) -> Any:
+        item = super().__getitem__(key)
+        return item.item() if isinstance(item, np.generic) else item
+
+    def __repr__(self) -> str:
+        if self.ndim != 1:
+            return super().__repr__()
+        return f"array('{_TYPECODES.get(self.dtype.char, self.dtype.char)}', {self.tolist()})"
+
+    __str__ = __repr__
 
     def _field(self) -> tuple[Any, str, np.ndarray]:
         target = None if self._owner is None else self._owner[0]()

@@ -135,6 +135,7 @@ class ActionClient:
         self._lock = threading.Lock()
         self._feedback_callbacks: dict[bytes, Callable[[Any], Any]] = {}
         self._goal_handles: dict[bytes, weakref.ref[ClientGoalHandle]] = {}
+        self._early: dict[bytes, list[Any]] = {}  # feedback that came before the goal response
 
     @property
     def action_type(self) -> type[ActionType]:
@@ -180,18 +181,25 @@ class ActionClient:
         """
         request = self._request(goal, goal_uuid)
         key = bytes(request.goal_id.uuid)
-        if feedback_callback is not None:
-            with self._lock:
+        with self._lock:
+            if feedback_callback is not None:
                 self._feedback_callbacks[key] = feedback_callback
+            self._early[key] = []
         future: Future[ClientGoalHandle] = Future()
         sent = self._goal_client.call_async(request)
 
         def answered(call: Future[Any]) -> None:
             error = call.exception()
             if error is not None:
+                with self._lock:
+                    self._early.pop(key, None)
                 future.set_exception(error)
                 return
             future.set_result(self._handle(request.goal_id, call.result()))
+            with self._lock:  # as rclpy: the goal response first, then its feedback
+                early = self._early.pop(key, [])
+            for message in early:
+                self._on_feedback(message)
 
         sent.add_done_callback(answered)
         return future
@@ -249,8 +257,12 @@ class ActionClient:
     # --- topics ------------------------------------------------------------------------------
 
     def _on_feedback(self, message: Any) -> Any:
+        key = bytes(message.goal_id.uuid)
         with self._lock:
-            callback = self._feedback_callbacks.get(bytes(message.goal_id.uuid))
+            if key in self._early:
+                self._early[key].append(message)
+                return None
+            callback = self._feedback_callbacks.get(key)
         return None if callback is None else callback(message)
 
     def _on_status(self, message: Any) -> None:

@@ -1,0 +1,230 @@
+"""rclpy action programs for the action tests, written as ROS 2's examples write them.
+
+The server follows ros2/examples' minimal_action_server (goal, cancel and execute callbacks;
+a coroutine execute callback under a MultiThreadedExecutor with a reentrant group) with
+options for the other variants; the clients follow minimal_action_client (feedback, result)
+and its cancelling variant. Our own code, run unmodified through rosl's rclpy.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+RUN_AS_RCLPY = (
+    "import rosl.compat; rosl.compat.install(force=True); import runpy, sys; "
+    "sys.argv = sys.argv[1:]; runpy.run_path(sys.argv[0], run_name='__main__')"
+)
+
+SERVER = """
+import sys
+import time
+
+import rclpy
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.node import Node
+
+from example_interfaces.action import Fibonacci
+
+OPTIONS = dict(zip(sys.argv[1::2], sys.argv[2::2]))
+DELAY = float(OPTIONS.get("--delay", "0.1"))
+
+
+class FibonacciServer(Node):
+    def __init__(self):
+        super().__init__("fibonacci_server")
+        extra = {}
+        if OPTIONS.get("--executor", "multi") == "multi":
+            extra["callback_group"] = ReentrantCallbackGroup()
+        if OPTIONS.get("--execute", "coroutine") == "coroutine":
+            execute = self.execute_coroutine
+        else:
+            execute = self.execute_plain
+        self._action_server = ActionServer(
+            self,
+            Fibonacci,
+            "fibonacci",
+            execute_callback=execute,
+            goal_callback=self.goal_callback,
+            cancel_callback=self.cancel_callback,
+            result_timeout=float(OPTIONS.get("--result-timeout", "900")),
+            **extra,
+        )
+        print("ready", flush=True)
+
+    def goal_callback(self, goal_request):
+        print(f"goal request: order {goal_request.order}", flush=True)
+        return GoalResponse.ACCEPT if goal_request.order >= 0 else GoalResponse.REJECT
+
+    def cancel_callback(self, goal_handle):
+        print("cancel request", flush=True)
+        if OPTIONS.get("--cancel", "accept") == "accept":
+            return CancelResponse.ACCEPT
+        return CancelResponse.REJECT
+
+    def steps(self, goal_handle):
+        feedback_msg = Fibonacci.Feedback()
+        feedback_msg.sequence = [0, 1]
+        for i in range(1, goal_handle.request.order):
+            if goal_handle.is_cancel_requested:
+                goal_handle.canceled()
+                print("goal canceled", flush=True)
+                return Fibonacci.Result()
+            feedback_msg.sequence.append(feedback_msg.sequence[i] + feedback_msg.sequence[i - 1])
+            goal_handle.publish_feedback(feedback_msg)
+            time.sleep(DELAY)
+        goal_handle.succeed()
+        result = Fibonacci.Result()
+        result.sequence = feedback_msg.sequence
+        print(f"result: {list(result.sequence)}", flush=True)
+        return result
+
+    async def execute_coroutine(self, goal_handle):
+        return self.steps(goal_handle)
+
+    def execute_plain(self, goal_handle):
+        return self.steps(goal_handle)
+
+
+def main():
+    rclpy.init()
+    node = FibonacciServer()
+    if OPTIONS.get("--executor", "multi") == "multi":
+        executor = MultiThreadedExecutor()
+    else:
+        executor = SingleThreadedExecutor()
+    rclpy.spin(node, executor=executor)
+
+
+if __name__ == "__main__":
+    main()
+"""
+
+CLIENT = """
+import rclpy
+from action_msgs.msg import GoalStatus
+from rclpy.action import ActionClient
+from rclpy.node import Node
+
+from example_interfaces.action import Fibonacci
+
+
+class MinimalActionClient(Node):
+    def __init__(self):
+        super().__init__("minimal_action_client")
+        self._action_client = ActionClient(self, Fibonacci, "fibonacci")
+
+    def goal_response_callback(self, future):
+        goal_handle = future.result()
+        if not goal_handle.accepted:
+            print("Goal rejected :(", flush=True)
+            return
+        print("Goal accepted :)", flush=True)
+        self._get_result_future = goal_handle.get_result_async()
+        self._get_result_future.add_done_callback(self.get_result_callback)
+
+    def feedback_callback(self, feedback):
+        print(f"Received feedback: {list(feedback.feedback.sequence)}", flush=True)
+
+    def get_result_callback(self, future):
+        result = future.result().result
+        status = future.result().status
+        if status == GoalStatus.STATUS_SUCCEEDED:
+            print(f"Goal succeeded! Result: {list(result.sequence)}", flush=True)
+        else:
+            print(f"Goal failed with status: {status}", flush=True)
+        rclpy.shutdown()
+
+    def send_goal(self):
+        self._action_client.wait_for_server()
+        goal_msg = Fibonacci.Goal()
+        goal_msg.order = 10
+        self._send_goal_future = self._action_client.send_goal_async(
+            goal_msg, feedback_callback=self.feedback_callback
+        )
+        self._send_goal_future.add_done_callback(self.goal_response_callback)
+
+
+def main():
+    rclpy.init()
+    action_client = MinimalActionClient()
+    action_client.send_goal()
+    rclpy.spin(action_client)
+
+
+if __name__ == "__main__":
+    main()
+"""
+
+CANCELLING_CLIENT = """
+import rclpy
+from rclpy.action import ActionClient
+from rclpy.node import Node
+
+from example_interfaces.action import Fibonacci
+
+
+class MinimalActionClient(Node):
+    def __init__(self):
+        super().__init__("minimal_action_client")
+        self._action_client = ActionClient(self, Fibonacci, "fibonacci")
+
+    def cancel_done(self, future):
+        cancel_response = future.result()
+        if len(cancel_response.goals_canceling) > 0:
+            print("Goal successfully canceled", flush=True)
+        else:
+            print(f"Goal failed to cancel: code {cancel_response.return_code}", flush=True)
+        rclpy.shutdown()
+
+    def goal_response_callback(self, future):
+        goal_handle = future.result()
+        if not goal_handle.accepted:
+            print("Goal rejected :(", flush=True)
+            return
+        self._goal_handle = goal_handle
+        print("Goal accepted :)", flush=True)
+
+    def feedback_callback(self, feedback):
+        print(f"Received feedback: {list(feedback.feedback.sequence)}", flush=True)
+        if len(feedback.feedback.sequence) >= 4 and self._timer is None:
+            self._timer = self.create_timer(0.1, self.timer_callback)
+
+    def timer_callback(self):
+        print("Canceling goal", flush=True)
+        future = self._goal_handle.cancel_goal_async()
+        future.add_done_callback(self.cancel_done)
+        self._timer.cancel()
+
+    def send_goal(self):
+        self._timer = None
+        self._action_client.wait_for_server()
+        goal_msg = Fibonacci.Goal()
+        goal_msg.order = 40
+        self._send_goal_future = self._action_client.send_goal_async(
+            goal_msg, feedback_callback=self.feedback_callback
+        )
+        self._send_goal_future.add_done_callback(self.goal_response_callback)
+
+
+def main():
+    rclpy.init()
+    action_client = MinimalActionClient()
+    action_client.send_goal()
+    rclpy.spin(action_client)
+
+
+if __name__ == "__main__":
+    main()
+"""
+
+
+def write(folder: Path, name: str, source: str) -> str:
+    """Write a program and return its path."""
+    path = folder / name
+    path.write_text(source.lstrip())
+    return str(path)
