@@ -65,13 +65,13 @@ def node_info(
             if endpoint.kind == kind and visible(endpoint.name, include_hidden):
                 entries.setdefault(endpoint.name, set()).add(endpoint.type)
         lines += [f"    {n}: {', '.join(sorted(t))}" for n, t in sorted(entries.items())]
-    for title, found in (
+    for title, named in (
         ("Action Servers", actions.servers(node)),
         ("Action Clients", actions.clients(node)),
     ):
         lines.append(f"  {title}:")
         lines += [
-            f"    {n}: {', '.join(t)}" for n, t in found.items() if visible(n, include_hidden)
+            f"    {n}: {', '.join(t)}" for n, t in named.items() if visible(n, include_hidden)
         ]
     lines.append("")
     return _blank_empty_sections(lines), warnings
