@@ -81,7 +81,7 @@ class SequenceArray(np.ndarray):
     def pop(self, index: int = -1) -> Any:
         """Remove the value at ``index`` (the last by default) and return it."""
         target, attr, current = self._field()
-        value = current[index].item()
+        value = current[index]  # a Python number (see __getitem__)
         setattr(target, attr, np.delete(current.view(np.ndarray), index))
         return value
 
