@@ -241,7 +241,6 @@ class ActionServer:
             handle = ServerGoalHandle(self, info, request.goal)
             with self._lock:
                 self._goal_handles[key] = handle
-            self._publish_status()
         reply(self._action_type.Impl.SendGoalService.Response(accepted=accepted, stamp=stamp))
         if handle is not None:
             await await_or_execute(self._handle_accepted_callback, handle)

@@ -12,6 +12,8 @@ from tests.node.action_programs import (
     CLIENT,
     RUN_AS_RCLPY,
     SERVER,
+    TUTORIAL_CLIENT,
+    TUTORIAL_SERVER,
     write,
 )
 from tests.node.helpers import spin_until
@@ -85,6 +87,23 @@ def test_a_client_cancels_a_running_goal_and_the_server_stops_it(
     served.expect("^goal canceled$")
     client.finish()
     assert client.returncode == 0
+
+
+def test_the_action_tutorials_server_and_client_run_unchanged(spawn: Any, tmp_path: Path) -> None:
+    server = spawn.command(
+        [sys.executable, "-c", RUN_AS_RCLPY, write(tmp_path, "server.py", TUTORIAL_SERVER)]
+    )
+    server.expect("^ready$")
+    client = spawn.command(
+        [sys.executable, "-c", RUN_AS_RCLPY, write(tmp_path, "client.py", TUTORIAL_CLIENT)]
+    )
+
+    client.expect(r"^Received feedback: array\('i', \[0, 1, 1\]\)$")
+    client.expect(r"^Received feedback: array\('i', \[0, 1, 1, 2, 3, 5\]\)$")
+    client.expect(r"^Result: array\('i', \[0, 1, 1, 2, 3, 5\]\)$")
+    client.finish()
+    assert client.returncode == 0
+    server.expect(r"Feedback: array\('i', \[0, 1, 1, 2, 3, 5\]\)$", stream="err")
 
 
 def test_a_rejected_goal_has_no_result(ros: Any, server: Any) -> None:
