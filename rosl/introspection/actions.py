@@ -112,7 +112,7 @@ def send_goal(
         yield "Goal was rejected."
         return
     yield f"Goal accepted with ID: {bytes(handle.goal_id.uuid).hex()}\n"
-    result = yield from _spin(node, handle.get_result_async(), shown)
+    result = yield from _spin(node, handle.get_result_async(), shown, last=True)
     if result is None:
         yield from _cancel(node, handle)
         return
@@ -122,17 +122,23 @@ def send_goal(
     yield f"Goal finished with status: {status_word(result.status)}"
 
 
-def _spin(node: Any, future: Future[Any], shown: list[str]) -> Generator[str, None, Any]:
-    """Serve the node until ``future`` is done (its result) or Ctrl-C (None), yielding feedback."""
+def _spin(
+    node: Any, future: Future[Any], shown: list[str], *, last: bool = False
+) -> Generator[str, None, Any]:
+    """Serve the node until ``future`` is done (its result) or Ctrl-C (None), yielding feedback.
+
+    Feedback that came with the goal's response waits for the next call (after the 'Goal
+    accepted' line); the ``last`` call yields all of it before returning.
+    """
     import rosl
 
     while not future.done():
         if not node.context.ok():
             return None
         rosl.spin_once(node, timeout_sec=0.1)
-        while shown:
+        while shown and not future.done():
             yield shown.pop(0)
-    while shown:
+    while shown and last:
         yield shown.pop(0)
     return future.result()
 

@@ -11,7 +11,7 @@ goals run their execute callback as an executor task; a goal's result is kept
 
 from __future__ import annotations
 
-import functools
+import inspect
 import threading
 from typing import TYPE_CHECKING, Any
 
@@ -24,7 +24,7 @@ from rosl.node.service import Service
 from rosl.node.task import Future
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Coroutine
 
     from rosl.idl.base import ActionType, ServiceType
     from rosl.node.callback_groups import CallbackGroup
@@ -34,10 +34,38 @@ if TYPE_CHECKING:
 
 
 class ActionService(Service):
-    """A service whose handler answers through ``reply(response)``, now or later."""
+    """A service whose handler answers through ``reply(response)``, now or later.
+
+    A handler that raises before it replied answers the caller with the failure at once (as
+    a plain service does), so a client is never left waiting for a goal response.
+    """
 
     def _answer(self, request: Any, address: tuple[int, int, int]) -> Any:
-        return self.callback(request, functools.partial(self._respond, address=address))
+        replied: list[bool] = []
+
+        def reply(response: Any) -> None:
+            replied.append(True)
+            self._respond(response, address)
+
+        try:
+            result = self.callback(request, reply)
+        except Exception as err:
+            if not replied:
+                self._fail(err, address)
+            raise
+        if inspect.iscoroutine(result):
+            return self._guarded(result, address, replied)
+        return None
+
+    async def _guarded(
+        self, pending: Coroutine[Any, Any, Any], address: tuple[int, int, int], replied: list[bool]
+    ) -> Any:
+        try:
+            return await pending
+        except Exception as err:
+            if not replied:
+                self._fail(err, address)
+            raise
 
 
 class ServerGoalHandle:

@@ -58,6 +58,8 @@ class FibonacciServer(Node):
 
     def goal_callback(self, goal_request):
         print(f"goal request: order {goal_request.order}", flush=True)
+        if goal_request.order == 99:
+            raise RuntimeError("no goals of order 99")
         return GoalResponse.ACCEPT if goal_request.order >= 0 else GoalResponse.REJECT
 
     def cancel_callback(self, goal_handle):

@@ -118,6 +118,20 @@ def test_a_rejected_goal_has_no_result(ros: Any, server: Any) -> None:
     served.expect("^goal request: order -1$")
 
 
+def test_a_goal_callback_that_raises_fails_the_goal_request_at_once(ros: Any, server: Any) -> None:
+    from rosl.node.client import ServiceFailedError
+
+    served = server()
+    node, client, fibonacci = _client(ros)
+    sent = client.send_goal_async(fibonacci.Goal(order=99))
+
+    assert spin_until(node, sent.done, 20.0), "the goal request was never answered"
+    assert isinstance(sent.exception(), ServiceFailedError)
+    assert "RuntimeError: no goals of order 99" in str(sent.exception())
+    served.expect("no goals of order 99", stream="err")
+    assert _wait(node, client.send_goal_async(fibonacci.Goal(order=2))).accepted  # still serving
+
+
 def test_a_cancel_the_server_refuses_leaves_the_goal_running(ros: Any, server: Any) -> None:
     served = server("--cancel", "reject", "--delay", "0.05")
     node, client, fibonacci = _client(ros)
