@@ -73,7 +73,6 @@ def node_info(
         lines += [
             f"    {n}: {', '.join(t)}" for n, t in named.items() if visible(n, include_hidden)
         ]
-    lines.append("")
     return _blank_empty_sections(lines), warnings
 
 

@@ -4,6 +4,7 @@ interface, node and topic commands."""
 from __future__ import annotations
 
 import re
+import signal
 import sys
 from typing import TYPE_CHECKING
 
@@ -175,3 +176,49 @@ def test_interface_lists_include_actions(rosl: Callable[..., Result]) -> None:
     assert f"    {TYPE}" in rosl("interface", "list", "-a").out.splitlines()
     assert TYPE in rosl("interface", "package", "example_interfaces").out.splitlines()
     assert "example_interfaces" in rosl("interface", "packages", "-a").out.splitlines()
+
+
+def test_ctrl_c_during_send_goal_cancels_the_goal_on_the_server(fibonacci, processes) -> None:
+    from tests.conftest import ChildOutput, wait_until
+
+    child = processes.rosl(
+        "action", "send_goal", "/fibonacci", TYPE, "{order: 60}", env={"NO_COLOR": "1"}
+    )
+    output = ChildOutput(child)
+
+    def accepted() -> bool:
+        output.pump()
+        return "Goal accepted with ID" in output.text["out"]
+
+    assert wait_until(accepted, timeout=30.0), output.text
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=30)
+    text = output.text["out"] + out
+
+    assert text.splitlines()[-2:] == ["Canceling goal...", "Goal canceled."], text + err
+    assert child.returncode == 130
+
+
+CLIENT_NODE = """
+import rosl
+from example_interfaces.action import Fibonacci
+from rosl.compat.rclpy.action import ActionClient
+
+rosl.init()
+node = rosl.Node("fib_client")
+client = ActionClient(node, Fibonacci, "fibonacci")
+rosl.spin(node)
+"""
+
+
+def test_an_action_client_shows_in_node_info_and_action_info(fibonacci, processes) -> None:
+    from rosl.graph.records import SUBSCRIPTION
+
+    processes.python(CLIENT_NODE)
+    wait_graph(lambda g: g.count(SUBSCRIPTION, FEEDBACK) == 1)
+
+    out = run(processes, "node", "info", "/fib_client").out
+    info = run(processes, "action", "info", "/fibonacci").out
+
+    assert out.endswith(f"  Action Servers:\n\n  Action Clients:\n    /fibonacci: {TYPE}\n")
+    assert "Action clients: 1\n    /fib_client\nAction servers: 1\n" in info
