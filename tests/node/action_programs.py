@@ -330,3 +330,69 @@ def main(args=None):
 if __name__ == '__main__':
     main()
 """
+
+
+QUEUE_SERVER = """
+import collections
+import threading
+import time
+
+import rclpy
+from rclpy.action import ActionServer
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import MultiThreadedExecutor
+from rclpy.node import Node
+
+from example_interfaces.action import Fibonacci
+
+
+class QueueServer(Node):
+    \"\"\"Goals wait their turn: the accepted callback starts one and queues the others.\"\"\"
+
+    def __init__(self):
+        super().__init__('queue_server')
+        self._goal_queue = collections.deque()
+        self._goal_queue_lock = threading.Lock()
+        self._current_goal = None
+        self._action_server = ActionServer(
+            self, Fibonacci, 'fibonacci',
+            handle_accepted_callback=self.handle_accepted_callback,
+            execute_callback=self.execute_callback,
+            callback_group=ReentrantCallbackGroup())
+        print('ready', flush=True)
+
+    def handle_accepted_callback(self, goal_handle):
+        with self._goal_queue_lock:
+            if self._current_goal is not None:
+                self._goal_queue.append(goal_handle)
+                print(f'queued order {goal_handle.request.order}', flush=True)
+            else:
+                self._current_goal = goal_handle
+                self._current_goal.execute()
+
+    def execute_callback(self, goal_handle):
+        try:
+            print(f'executing order {goal_handle.request.order}', flush=True)
+            sequence = [0, 1]
+            for i in range(1, goal_handle.request.order):
+                sequence.append(sequence[i] + sequence[i - 1])
+                time.sleep(0.1)
+            goal_handle.succeed()
+            return Fibonacci.Result(sequence=sequence)
+        finally:
+            with self._goal_queue_lock:
+                try:
+                    self._current_goal = self._goal_queue.popleft()
+                    self._current_goal.execute()
+                except IndexError:
+                    self._current_goal = None
+
+
+def main():
+    rclpy.init()
+    rclpy.spin(QueueServer(), executor=MultiThreadedExecutor())
+
+
+if __name__ == '__main__':
+    main()
+"""

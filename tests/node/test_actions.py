@@ -10,6 +10,7 @@ import pytest
 from tests.node.action_programs import (
     CANCELLING_CLIENT,
     CLIENT,
+    QUEUE_SERVER,
     RUN_AS_RCLPY,
     SERVER,
     TUTORIAL_CLIENT,
@@ -104,6 +105,28 @@ def test_the_action_tutorials_server_and_client_run_unchanged(spawn: Any, tmp_pa
     client.finish()
     assert client.returncode == 0
     server.expect(r"Feedback: array\('i', \[0, 1, 1, 2, 3, 5\]\)$", stream="err")
+
+
+def test_an_accepted_callback_queues_goals_that_wait_in_the_accepted_state(
+    ros: Any, spawn: Any, tmp_path: Path
+) -> None:
+    queue = spawn.command(
+        [sys.executable, "-c", RUN_AS_RCLPY, write(tmp_path, "queue.py", QUEUE_SERVER)]
+    )
+    queue.expect("^ready$")
+    node, client, fibonacci = _client(ros)
+
+    first = _wait(node, client.send_goal_async(fibonacci.Goal(order=6)))
+    second = _wait(node, client.send_goal_async(fibonacci.Goal(order=3)))
+    queue.expect("^executing order 6$")
+    queue.expect("^queued order 3$")
+    waiting = second.status
+    results = [_wait(node, first.get_result_async()), _wait(node, second.get_result_async())]
+
+    assert waiting == 1  # ACCEPTED, not executing, while the first goal runs
+    assert [r.status for r in results] == [SUCCEEDED, SUCCEEDED]
+    assert list(results[1].result.sequence) == [0, 1, 1, 2]
+    queue.expect("^executing order 3$")
 
 
 def test_a_rejected_goal_has_no_result(ros: Any, server: Any) -> None:
