@@ -95,6 +95,12 @@ def sequence_property(slot: str, attr: str, coerce: Callable[[Any], Any]) -> pro
         object.__setattr__(self, slot, array)
 
     def getter(self: Any) -> Any:
-        return getattr(self, slot)
+        array = getattr(self, slot)
+        owner = array._owner
+        if owner is None or owner[0]() is not self:  # a copied message: its own view
+            array = array.view(SequenceArray)
+            array._owner = (weakref.ref(self), attr)
+            object.__setattr__(self, slot, array)
+        return array
 
     return property(getter, setter)

@@ -138,6 +138,24 @@ def test_a_sequence_field_grows_like_rclpys_array() -> None:
         feedback.sequence[1:].append(1)
 
 
+def test_a_copied_message_grows_its_own_sequence() -> None:
+    import copy
+
+    from example_interfaces.action import Fibonacci
+
+    original = Fibonacci.Feedback(sequence=[0, 1])
+    shallow, deep = copy.copy(original), copy.deepcopy(original)
+    shallow.sequence.append(2)
+    deep.sequence.append(3)
+    original.sequence.append(4)
+
+    assert [list(m.sequence) for m in (original, shallow, deep)] == [
+        [0, 1, 4],
+        [0, 1, 2],
+        [0, 1, 3],
+    ]
+
+
 def test_an_unknown_action_names_the_closest() -> None:
     with pytest.raises(InterfaceError, match="did you mean 'Fibonacci'"):
         registry.get_action_class("example_interfaces/action/Fibonaci")
