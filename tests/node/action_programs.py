@@ -20,6 +20,7 @@ RUN_AS_RCLPY = (
 
 SERVER = """
 import sys
+import threading
 import time
 
 import rclpy
@@ -37,6 +38,7 @@ DELAY = float(OPTIONS.get("--delay", "0.1"))
 class FibonacciServer(Node):
     def __init__(self):
         super().__init__("fibonacci_server")
+        self.cancel_seen = threading.Event()
         extra = {}
         if OPTIONS.get("--executor", "multi") == "multi":
             extra["callback_group"] = ReentrantCallbackGroup()
@@ -64,6 +66,7 @@ class FibonacciServer(Node):
 
     def cancel_callback(self, goal_handle):
         print("cancel request", flush=True)
+        self.cancel_seen.set()
         if OPTIONS.get("--cancel", "accept") == "accept":
             return CancelResponse.ACCEPT
         return CancelResponse.REJECT
@@ -71,6 +74,8 @@ class FibonacciServer(Node):
     def steps(self, goal_handle):
         feedback_msg = Fibonacci.Feedback()
         feedback_msg.sequence = [0, 1]
+        if OPTIONS.get("--hold") == "until-cancel":  # finish only after a cancel request
+            self.cancel_seen.wait(60)
         for i in range(1, goal_handle.request.order):
             if goal_handle.is_cancel_requested:
                 goal_handle.canceled()

@@ -110,23 +110,36 @@ def test_the_action_tutorials_server_and_client_run_unchanged(spawn: Any, tmp_pa
 def test_an_accepted_callback_queues_goals_that_wait_in_the_accepted_state(
     ros: Any, spawn: Any, tmp_path: Path
 ) -> None:
+    from rosl.idl.registry import get_message_class
+    from rosl.node.qos import DurabilityPolicy, QoSProfile
+
     queue = spawn.command(
         [sys.executable, "-c", RUN_AS_RCLPY, write(tmp_path, "queue.py", QUEUE_SERVER)]
     )
     queue.expect("^ready$")
     node, client, fibonacci = _client(ros)
+    arrays: list[dict[bytes, int]] = []
+    node.create_subscription(
+        get_message_class("action_msgs/msg/GoalStatusArray"), "/fibonacci/_action/status",
+        lambda msg: arrays.append(
+            {bytes(s.goal_info.goal_id.uuid): int(s.status) for s in msg.status_list}
+        ),
+        QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL),
+    )  # fmt: skip
 
     first = _wait(node, client.send_goal_async(fibonacci.Goal(order=6)))
     second = _wait(node, client.send_goal_async(fibonacci.Goal(order=3)))
-    queue.expect("^executing order 6$")
-    queue.expect("^queued order 3$")
-    waiting = second.status
     results = [_wait(node, first.get_result_async()), _wait(node, second.get_result_async())]
+    ids = (bytes(first.goal_id.uuid), bytes(second.goal_id.uuid))
+    assert spin_until(node, lambda: {ids[0]: 4, ids[1]: 4} in arrays, 10.0), arrays
 
-    assert waiting == 1  # ACCEPTED, not executing, while the first goal runs
     assert [r.status for r in results] == [SUCCEEDED, SUCCEEDED]
     assert list(results[1].result.sequence) == [0, 1, 1, 2]
+    # the second goal waited, ACCEPTED, until the first ended; they never ran together
+    assert {ids[0]: SUCCEEDED, ids[1]: 1} in arrays, arrays
+    assert not [a for a in arrays if a.get(ids[0]) == 2 and a.get(ids[1]) == 2]
     queue.expect("^executing order 3$")
+    assert queue.count("^executing order 6$") == queue.count("^queued order 3$") == 1
 
 
 def test_a_rejected_goal_has_no_result(ros: Any, server: Any) -> None:
@@ -156,7 +169,7 @@ def test_a_goal_callback_that_raises_fails_the_goal_request_at_once(ros: Any, se
 
 
 def test_a_cancel_the_server_refuses_leaves_the_goal_running(ros: Any, server: Any) -> None:
-    served = server("--cancel", "reject", "--delay", "0.05")
+    served = server("--cancel", "reject", "--hold", "until-cancel", "--delay", "0")
     node, client, fibonacci = _client(ros)
     handle = _wait(node, client.send_goal_async(fibonacci.Goal(order=12)))
 
@@ -189,7 +202,7 @@ def test_the_status_array_follows_a_goal_and_a_late_subscriber_gets_the_last_one
     ros: Any, server: Any
 ) -> None:
     from rosl.idl.registry import get_message_class
-    from rosl.node.qos import qos_profile_action_status_default
+    from rosl.node.qos import DurabilityPolicy, QoSProfile, qos_profile_action_status_default
 
     server("--delay", "0.05")
     node, client, fibonacci = _client(ros)
@@ -198,7 +211,7 @@ def test_the_status_array_follows_a_goal_and_a_late_subscriber_gets_the_last_one
     node.create_subscription(
         status_type, "/fibonacci/_action/status",
         lambda msg: seen.append([int(s.status) for s in msg.status_list]),
-        qos_profile_action_status_default,
+        QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL),  # keeps every one
     )  # fmt: skip
     handle = _wait(node, client.send_goal_async(fibonacci.Goal(order=5)))
     _wait(node, handle.get_result_async())
@@ -221,7 +234,7 @@ def test_a_result_is_kept_until_the_goal_expires(ros: Any, server: Any) -> None:
     from rosl.idl.registry import get_message_class
     from rosl.node.qos import qos_profile_action_status_default
 
-    server("--result-timeout", "1.0", "--delay", "0")
+    server("--result-timeout", "5.0", "--delay", "0")  # 5 s: room for the second request
     node, client, fibonacci = _client(ros)
     arrays: list[Any] = []
     node.create_subscription(
@@ -285,7 +298,12 @@ def test_graph_queries_name_the_action_and_its_nodes(ros: Any, server: Any) -> N
     node, _, _ = _client(ros)
     wanted = [("/fibonacci", ["example_interfaces/action/Fibonacci"])]
 
-    assert spin_until(node, lambda: get_action_names_and_types(node) == wanted, 10.0)
-    assert get_action_server_names_and_types_by_node(node, "fibonacci_server", "/") == wanted
-    assert get_action_client_names_and_types_by_node(node, "action_tester", "/") == wanted
-    assert get_action_server_names_and_types_by_node(node, "action_tester", "/") == []
+    def answers() -> list[Any]:
+        return [
+            get_action_names_and_types(node),
+            get_action_server_names_and_types_by_node(node, "fibonacci_server", "/"),
+            get_action_client_names_and_types_by_node(node, "action_tester", "/"),
+            get_action_server_names_and_types_by_node(node, "action_tester", "/"),
+        ]
+
+    assert spin_until(node, lambda: answers() == [wanted, wanted, wanted, []], 20.0), answers()
