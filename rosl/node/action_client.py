@@ -3,8 +3,10 @@
 Goals go out on ``<action>/_action/send_goal``, results and cancels on ``get_result`` and
 ``cancel_goal``; feedback (``<action>/_action/feedback``) reaches the callback given with the
 goal, and the status array (``<action>/_action/status``) keeps each goal handle's ``status``
-current. The blocking calls (``send_goal``, ``get_result``, ``cancel_goal``) work inside
-callbacks too, as :meth:`rosl.node.client.Client.call` does.
+current. A goal's feedback received before its result is handed to the feedback callback
+before the result future completes (the executor would otherwise take the result first).
+The blocking calls (``send_goal``, ``get_result``, ``cancel_goal``) work inside callbacks
+too, as :meth:`rosl.node.client.Client.call` does.
 """
 
 from __future__ import annotations
@@ -239,6 +241,7 @@ class ActionClient:
         return future.result()
 
     def _ended(self, handle: ClientGoalHandle, done: Future[Any]) -> None:
+        self._drain_feedback()
         key = bytes(handle.goal_id.uuid)
         with self._lock:
             self._feedback_callbacks.pop(key, None)
@@ -246,6 +249,14 @@ class ActionClient:
         response = None if done.exception() is not None else done.result()
         if response is not None:
             handle._status = int(response.status)
+
+    def _drain_feedback(self) -> None:
+        """Run the feedback already received before a result: the server sent it earlier."""
+        subscription = self._feedback_sub
+        while subscription._queue:
+            work = subscription._take()
+            if work is not None:
+                work()
 
     def _cancel_request(self, handle: ClientGoalHandle) -> Any:
         info = get_message_class("action_msgs/msg/GoalInfo")(goal_id=handle.goal_id)

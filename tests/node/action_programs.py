@@ -28,6 +28,7 @@ from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.task import Future
 
 from example_interfaces.action import Fibonacci
 
@@ -42,10 +43,11 @@ class FibonacciServer(Node):
         extra = {}
         if OPTIONS.get("--executor", "multi") == "multi":
             extra["callback_group"] = ReentrantCallbackGroup()
-        if OPTIONS.get("--execute", "coroutine") == "coroutine":
-            execute = self.execute_coroutine
-        else:
-            execute = self.execute_plain
+        execute = {
+            "coroutine": self.execute_coroutine,
+            "plain": self.execute_plain,
+            "awaiting": self.execute_awaiting,
+        }[OPTIONS.get("--execute", "coroutine")]
         self._action_server = ActionServer(
             self,
             Fibonacci,
@@ -94,6 +96,15 @@ class FibonacciServer(Node):
         return self.steps(goal_handle)
 
     def execute_plain(self, goal_handle):
+        return self.steps(goal_handle)
+
+    async def execute_awaiting(self, goal_handle):
+        # suspends on a future a timer completes: the executor runs other callbacks meanwhile
+        ready = Future()
+        timer = self.create_timer(0.05, lambda: ready.done() or ready.set_result(True))
+        await ready
+        timer.cancel()
+        print("awaited", flush=True)
         return self.steps(goal_handle)
 
 

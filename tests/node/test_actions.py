@@ -257,8 +257,11 @@ def test_a_result_is_kept_until_the_goal_expires(ros: Any, server: Any) -> None:
     assert expired.status == UNKNOWN
 
 
-def test_a_single_threaded_server_with_a_plain_execute_callback(ros: Any, server: Any) -> None:
-    server("--executor", "single", "--execute", "plain", "--delay", "0")
+@pytest.mark.parametrize("execute", ["plain", "awaiting"])
+def test_a_single_threaded_server_with_a_plain_or_an_awaiting_execute_callback(
+    ros: Any, server: Any, execute: str
+) -> None:
+    served = server("--executor", "single", "--execute", execute, "--delay", "0")
     node, client, fibonacci = _client(ros)
     feedback: list[list[int]] = []
 
@@ -273,6 +276,7 @@ def test_a_single_threaded_server_with_a_plain_execute_callback(ros: Any, server
     assert result.status == SUCCEEDED
     assert list(result.result.sequence) == [0, 1, 1, 2, 3]
     assert spin_until(node, lambda: [0, 1, 1, 2, 3] in feedback, 10.0), feedback
+    assert served.count("^awaited$") == (execute == "awaiting")
 
 
 def test_send_goal_blocks_until_the_result_without_spinning(ros: Any, server: Any) -> None:
