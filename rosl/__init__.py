@@ -24,7 +24,7 @@ from rosl.errors import RoslError
 
 if TYPE_CHECKING:
     from rosl.executor import Executor, Future, MultiThreadedExecutor, SingleThreadedExecutor
-    from rosl.idl.messages import Message, ServiceType
+    from rosl.idl.messages import ActionType, Message, ServiceType
     from rosl.node.client import Client
     from rosl.node.clock import Clock, ClockType, Duration, Time
     from rosl.node.node import Node
@@ -129,8 +129,8 @@ __version__ = "0.1.0"
 _install_import_hook()
 
 
-def get_interface(type_name: str) -> type[Message] | type[ServiceType]:
-    """Return the class of a message or service type, e.g. ``"geometry_msgs/msg/Twist"``.
+def get_interface(type_name: str) -> type[Message] | type[ServiceType] | type[ActionType]:
+    """Return the class of a message, service or action type, e.g. ``"geometry_msgs/msg/Twist"``.
 
     Raises:
         rosl.idl.errors.InterfaceError: unknown type, or a bad definition file.

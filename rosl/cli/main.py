@@ -22,7 +22,7 @@ from rosl.errors import RoslError
 # name -> (module, one-line help); the module defines a click command named ``command``
 # (``module:name`` picks another attribute)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "action": ("rosl.cli.planned:action", "Actions: not in rosl yet"),
+    "action": ("rosl.cli.action", "Various action related sub-commands"),
     "bag": ("rosl.cli.bag", "Various rosbag related sub-commands"),
     "bridge": ("rosl.cli.bridge", "Serve the live bus to Foxglove (foxglove_bridge)"),
     "component": ("rosl.cli.planned:component", "Components: not in rosl (C++ only)"),

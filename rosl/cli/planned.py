@@ -1,7 +1,6 @@
-"""ROS 2 commands rosl does not have yet: each answers in one line and exits 1.
+"""ROS 2 commands rosl does not have: each answers in one line and exits 1.
 
-``rosl action`` comes with actions in a later version; ``rosl component`` loads C++
-components into a container, which pure Python cannot.
+``rosl component`` loads C++ components into a container, which pure Python cannot.
 """
 
 from __future__ import annotations
@@ -10,9 +9,7 @@ import click
 
 from rosl.errors import RoslError
 
-LATER = "{what} are not in rosl yet; they come in a later version"
 WHY_NOT = {
-    "action": LATER.format(what="actions"),
     "component": "components are not in rosl: they are C++ libraries a container process loads",
 }
 
@@ -35,5 +32,4 @@ def _planned(name: str) -> click.Command:
     return planned
 
 
-action = _planned("action")
 component = _planned("component")

@@ -13,12 +13,12 @@ from typing import Any
 # imported (copy imports org.python.core), would re-enter that half-built module
 from rosl.idl import search_path
 
-_KINDS = ("msg", "srv")
+_KINDS = ("msg", "srv", "action")
 _busy = threading.local()  # set while the finder itself imports or scans
 
 
 class InterfaceModule(types.ModuleType):
-    """``<pkg>.msg`` / ``<pkg>.srv``: attributes are interface classes, built on first access."""
+    """``<pkg>.msg`` / ``.srv`` / ``.action``: attributes are interface classes, built when used."""
 
     def __init__(self, name: str, package: str, kind: str) -> None:
         super().__init__(name)
@@ -79,7 +79,7 @@ def _is_real(spec: importlib.machinery.ModuleSpec | None) -> bool:
 
 
 class InterfaceFinder(importlib.abc.MetaPathFinder):
-    """Serve ``<pkg>`` and ``<pkg>.msg``/``<pkg>.srv`` for interface packages.
+    """Serve ``<pkg>`` and ``<pkg>.msg``/``.srv``/``.action`` for interface packages.
 
     It sits just before the standard path finder and defers to any real module of the same
     name, so installed Python packages always win; namespace folders (a ``msg/`` folder on

@@ -64,6 +64,24 @@ class ServiceType:
     Response: ClassVar[type[Message]]
 
 
+class ActionType:
+    """Base of generated action classes, as rosidl_generator_py makes them.
+
+    ``Goal``, ``Result`` and ``Feedback`` are message classes; ``Impl`` holds the generated
+    ``SendGoalService``, ``GetResultService`` and ``FeedbackMessage`` and action_msgs'
+    ``CancelGoalService`` and ``GoalStatusMessage``.
+    """
+
+    __actiontype__: ClassVar[str]
+    Goal: ClassVar[type[Message]]
+    Result: ClassVar[type[Message]]
+    Feedback: ClassVar[type[Message]]
+    Impl: ClassVar[Any]
+
+    def __init__(self) -> None:
+        raise NotImplementedError("Action classes can not be instantiated")
+
+
 def _equal(a: Any, b: Any) -> bool:
     import numpy as np
 

@@ -9,10 +9,10 @@ kept at the top level, dropped in nested definitions (``all_comments`` keeps the
 from __future__ import annotations
 
 from rosl.idl import registry
-from rosl.idl.base import ServiceType
+from rosl.idl.base import ActionType, ServiceType
 from rosl.idl.errors import InterfaceError
 from rosl.idl.names import TypeName, parse_type_name
-from rosl.idl.parser import ServiceSpec, split_comment
+from rosl.idl.parser import ActionSpec, ServiceSpec, split_comment
 
 
 def show(type_name: str, *, all_comments: bool = False, no_comments: bool = False) -> str:
@@ -30,9 +30,10 @@ def show(type_name: str, *, all_comments: bool = False, no_comments: bool = Fals
 def _interface_name(type_name: str) -> TypeName:
     name = parse_type_name(type_name)
     if type_name.count("/") == 1 and not registry.exists(str(name)):
-        srv = TypeName(name.package, "srv", name.name)
-        if registry.interface_path(srv).is_file():
-            return srv
+        for kind in ("srv", "action"):
+            other = TypeName(name.package, kind, name.name)
+            if registry.interface_path(other).is_file():
+                return other
     return name
 
 
@@ -44,7 +45,10 @@ def _show(
         raise InterfaceError(f"recursive message definition: {cycle}")
     level = len(parents)
     spec = registry.load_spec(type_name)
-    halves = [spec.request, spec.response] if isinstance(spec, ServiceSpec) else [spec]
+    if isinstance(spec, ActionSpec):
+        halves = list(spec.parts)
+    else:
+        halves = [spec.request, spec.response] if isinstance(spec, ServiceSpec) else [spec]
     resolved = {h.type_name: registry.resolve(h) for h in halves}
     lines = spec.text.splitlines()
     # map each line number to the field defined on it (for nesting)
@@ -66,9 +70,12 @@ def _show(
 
 
 def prototype(type_name: str) -> str:
-    """Return the YAML of a default instance (the request, for a service)."""
+    """Return the YAML of a default instance (the request of a service, an action's goal)."""
     from rosl.idl.yaml_io import message_to_yaml
 
     cls = registry.get_interface(str(_interface_name(type_name)))
-    message_cls = cls.Request if issubclass(cls, ServiceType) else cls
+    if issubclass(cls, ActionType):
+        message_cls = cls.Goal
+    else:
+        message_cls = cls.Request if issubclass(cls, ServiceType) else cls
     return message_to_yaml(message_cls())

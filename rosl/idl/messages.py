@@ -26,17 +26,20 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rosl.idl.base import Message, ServiceType
+from rosl.idl.base import ActionType, Message, ServiceType
 from rosl.idl.errors import FieldError
 from rosl.idl.names import did_you_mean, parse_type_name
 from rosl.idl.parser import FLOATS, INTEGER_RANGES, ArrayKind, FieldType
+from rosl.idl.sequences import SequenceArray, sequence_property
 
 if TYPE_CHECKING:
     from rosl.idl.parser import MessageSpec
 
 __all__ = [
+    "ActionType",
     "Message",
     "ServiceType",
+    "build_action_class",
     "build_message_class",
     "build_service_class",
     "from_dict",
@@ -62,6 +65,7 @@ DUMMY_FIELD = "structure_needs_at_least_one_member"
 
 
 _BYTES = tuple(bytes((i,)) for i in range(256))  # each byte value once, shared
+_ARRAYS = (np.ndarray, SequenceArray)
 
 
 def _scalar_default(ftype: FieldType, default: Any) -> Any:
@@ -129,9 +133,10 @@ def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
     def coerce(value: Any) -> Any:
         if value is None:
             return np.zeros(ftype.size if ftype.array is ArrayKind.FIXED else 0, dtype)
-        if type(value) is np.ndarray and value.dtype == dtype and value.ndim == 1:
-            # a read-only array is a view into received bytes: keep a copy the user may change
-            array = value if value.flags.writeable else value.copy()
+        if type(value) in _ARRAYS and value.dtype == dtype and value.ndim == 1:
+            array = value.view(np.ndarray)
+            if not array.flags.writeable:  # a view into received bytes: a copy the user may change
+                array = array.copy()
         elif eight_bit and isinstance(value, (bytes, bytearray, memoryview)):
             array = np.frombuffer(value, dtype=np.uint8).astype(dtype)  # one copy, no loop
         elif isinstance(value, py_array.array) and np.dtype(value.typecode) == dtype:
@@ -214,7 +219,11 @@ def build_message_class(
             default = None if field.default is None else list(field.default)
             namespace[f"_d{index}"] = default
             slots.append("_" + attr)
-            body[attr] = _array_property("_" + attr, coerce)
+            body[attr] = (
+                _array_property("_" + attr, coerce)
+                if ftype.array is ArrayKind.FIXED
+                else sequence_property("_" + attr, attr, coerce)
+            )
             params.append(f"{attr}=None")
             lines.append(f"    self.{attr} = _d{index} if {attr} is None else {attr}")
             continue
@@ -252,7 +261,7 @@ def build_message_class(
     )
     exec(compile(source, f"<rosl message {spec.type_name}>", "exec"), namespace)
     body.update(
-        __slots__=tuple(slots),
+        __slots__=(*slots, "__weakref__"),  # a sequence field's array refers back weakly
         __init__=namespace["__init__"],
         __msgtype__=spec.type_name,
         __module__=f"{name.package}.{name.kind}",
@@ -323,6 +332,52 @@ def build_service_class(
             "__doc__": f"The ROS service type {type_name}.",
             "Request": request,
             "Response": response,
+        },
+    )
+
+
+def build_action_class(
+    type_name: str,
+    messages: dict[str, type[Message]],
+    services: dict[str, type[ServiceType]],
+    cancel_goal: type[ServiceType],
+    goal_status_array: type[Message],
+) -> type[ActionType]:
+    """Generate the class for an action from its generated message and service classes.
+
+    Args:
+        type_name: ``pkg/action/Name``.
+        messages: the classes of ``_Goal``, ``_Result``, ``_Feedback``, ``_FeedbackMessage``.
+        services: the classes of ``_SendGoal`` and ``_GetResult``.
+        cancel_goal: action_msgs' CancelGoal service.
+        goal_status_array: action_msgs' GoalStatusArray message.
+    """
+    name = parse_type_name(type_name, "action")
+    impl = type(
+        "Impl",
+        (),
+        {
+            "__qualname__": f"{name.name}.Impl",
+            "__module__": f"{name.package}.action",
+            "SendGoalService": services["_SendGoal"],
+            "GetResultService": services["_GetResult"],
+            "FeedbackMessage": messages["_FeedbackMessage"],
+            "CancelGoalService": cancel_goal,
+            "GoalStatusMessage": goal_status_array,
+        },
+    )
+    return type(
+        name.name,
+        (ActionType,),
+        {
+            "__actiontype__": type_name,
+            "__module__": f"{name.package}.action",
+            "__qualname__": name.name,
+            "__doc__": f"The ROS action type {type_name}.",
+            "Goal": messages["_Goal"],
+            "Result": messages["_Result"],
+            "Feedback": messages["_Feedback"],
+            "Impl": impl,
         },
     )
 

@@ -1,8 +1,11 @@
 """Interface type names: one canonical spelling inside rosl, lenient spellings at the edges.
 
 Canonical names are ``pkg/msg/Name``, ``pkg/srv/Name`` and, for the two halves of a service,
-``pkg/srv/Name_Request`` / ``pkg/srv/Name_Response``. Users may also write ``pkg/Name``
-(a message, or a service where a service is expected) and ``pkg.msg.Name``.
+``pkg/srv/Name_Request`` / ``pkg/srv/Name_Response``. An action ``pkg/action/Name`` has the
+types rosidl generates for it: ``Name_Goal``, ``Name_Result``, ``Name_Feedback``,
+``Name_FeedbackMessage`` and the services ``Name_SendGoal`` / ``Name_GetResult`` (with their
+``_Request`` / ``_Response``). Users may also write ``pkg/Name`` (a message, or a service where a
+service is expected) and ``pkg.msg.Name``.
 """
 
 from __future__ import annotations
@@ -22,6 +25,11 @@ TYPE_NAME = re.compile(r"^[A-Z][A-Za-z0-9]*$")
 CONSTANT_NAME = re.compile(r"^[A-Z]([A-Z0-9_]?[A-Z0-9]+)*$")
 KINDS = ("msg", "srv", "action")
 SERVICE_SUFFIXES = ("_Request", "_Response", "_Event")
+# longest first: the first that matches is cut off
+ACTION_SUFFIXES = (
+    "_SendGoal_Request", "_SendGoal_Response", "_GetResult_Request", "_GetResult_Response",
+    "_FeedbackMessage", "_SendGoal", "_GetResult", "_Feedback", "_Result", "_Goal",
+)  # fmt: skip
 
 
 class TypeName(NamedTuple):
@@ -67,18 +75,22 @@ def parse_type_name(text: str, default_kind: str = "msg") -> TypeName:
         )
     if not PACKAGE_NAME.match(package):
         raise InterfaceError(f"invalid type name '{text}': '{package}' is not a package name")
-    base = name
-    if kind == "srv":
-        for suffix in SERVICE_SUFFIXES:
-            if name.endswith(suffix):
-                base = name[: -len(suffix)]
-                break
+    base = base_name(name, kind)
     if not TYPE_NAME.match(base):
         raise InterfaceError(
             f"invalid type name '{text}': '{name}' must start with a capital letter "
             "and hold only letters and digits"
         )
     return TypeName(package, kind, name)
+
+
+def base_name(name: str, kind: str) -> str:
+    """The interface a type belongs to: ``Fibonacci`` for ``Fibonacci_SendGoal_Request``."""
+    suffixes = SERVICE_SUFFIXES if kind == "srv" else ACTION_SUFFIXES if kind == "action" else ()
+    for suffix in suffixes:
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return name
 
 
 def canonical(text: str, default_kind: str = "msg") -> str:

@@ -4,8 +4,9 @@ Why our own parser: rosbags' parser accepts typos, reports character offsets and
 default values; rosidl's needs ROS installed. The grammar follows rosidl_adapter: one field
 (``type name [default]``) or constant (``type NAME=value``) per line, ``#`` comments, array
 suffixes ``[N]`` / ``[<=N]`` / ``[]``, bounded strings ``string<=N``, services split at a
-``---`` line. Type references are returned as written (qualified to ``pkg/msg/Name`` where the
-text says which package); resolving them against the search path is ``registry``'s job.
+``---`` line, actions in three parts (goal, result, feedback) at two ``---`` lines. Type
+references are returned as written (qualified to ``pkg/msg/Name`` where the text says which
+package); resolving them against the search path is ``registry``'s job.
 """
 
 from __future__ import annotations
@@ -143,6 +144,23 @@ class ServiceSpec:
     text: str = ""
 
 
+@dataclass(frozen=True, slots=True)
+class ActionSpec:
+    """A parsed action: its goal, result and feedback messages."""
+
+    type_name: str
+    goal: MessageSpec
+    result: MessageSpec
+    feedback: MessageSpec
+    path: str | None = None
+    text: str = ""
+
+    @property
+    def parts(self) -> tuple[MessageSpec, MessageSpec, MessageSpec]:
+        """Goal, result and feedback, in the file's order."""
+        return (self.goal, self.result, self.feedback)
+
+
 @dataclass(slots=True)
 class _Context:
     package: str
@@ -259,6 +277,52 @@ def parse_service(
     request = parse_message("\n".join(lines[:cut]), f"{type_name}_Request", path, 1)
     response = parse_message("\n".join(lines[cut + 1 :]), f"{type_name}_Response", path, cut + 2)
     return ServiceSpec(type_name, request, response, str(path) if path else None, text)
+
+
+def parse_action(
+    text: str, type_name: str, path: str | os.PathLike[str] | None = None
+) -> ActionSpec:
+    """Parse the text of an .action file into its goal, result and feedback.
+
+    Args:
+        text: the definition text.
+        type_name: the canonical name, ``pkg/action/Name``.
+        path: the file, for error locations.
+
+    Returns:
+        The parsed action; any part may be empty.
+
+    Raises:
+        InterfaceError: not exactly two separators, or a bad line in any part.
+    """
+    lines = text.splitlines()
+    separators = [i for i, raw in enumerate(lines) if split_comment(raw)[0].strip() == SEPARATOR]
+    if len(separators) < 2:
+        found = "no '---' line" if not separators else f"one '---' (line {separators[0] + 1})"
+        raise InterfaceError(
+            f"an action has three parts, goal, result and feedback, separated by two '---' "
+            f"lines; this file has {found}",
+            path,
+            len(lines) or 1,
+        )
+    if len(separators) > 2:
+        raise InterfaceError(
+            f"more than two '---' in an action (the others are on lines {separators[0] + 1} and "
+            f"{separators[1] + 1}); an .action file has goal, result and feedback parts",
+            path,
+            separators[2] + 1,
+            1,
+        )
+    first, second = separators
+    parts = []
+    for suffix, start, end in (
+        ("_Goal", 0, first), ("_Result", first + 1, second), ("_Feedback", second + 1, len(lines))
+    ):  # fmt: skip
+        parts.append(
+            parse_message("\n".join(lines[start:end]), f"{type_name}{suffix}", path, start + 1)
+        )
+    goal, result, feedback = parts
+    return ActionSpec(type_name, goal, result, feedback, str(path) if path else None, text)
 
 
 def _parse_line(code: str, ctx: _Context) -> Field | Constant:

@@ -14,20 +14,31 @@ from typing import TYPE_CHECKING
 
 from rosl.idl import search_path
 from rosl.idl.errors import InterfaceError
-from rosl.idl.names import TypeName, did_you_mean, parse_type_name
-from rosl.idl.parser import FieldType, MessageSpec, ServiceSpec, parse_message, parse_service
+from rosl.idl.names import TypeName, base_name, did_you_mean, parse_type_name
+from rosl.idl.parser import (
+    ActionSpec,
+    FieldType,
+    MessageSpec,
+    ServiceSpec,
+    parse_action,
+    parse_message,
+    parse_service,
+)
 
 if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from rosl.idl.base import ActionType
     from rosl.idl.messages import Message, ServiceType
     from rosl.idl.store import Store
 
+Spec = MessageSpec | ServiceSpec | ActionSpec
 _lock = threading.RLock()
-_specs: dict[str, MessageSpec | ServiceSpec] = {}
+_specs: dict[str, Spec] = {}
 _classes: dict[str, type[Message]] = {}
 _services: dict[str, type[ServiceType]] = {}
+_actions: dict[str, type[ActionType]] = {}
 _loading: list[str] = []
 _store: Store | None = None
 _clear_hooks: list[Callable[[], None]] = []  # e.g. import-hook modules dropping cached classes
@@ -45,9 +56,7 @@ def store() -> Store:
 
 def interface_path(name: TypeName) -> Path:
     """Return the file defining ``name`` (which may not exist)."""
-    base = name.name
-    if name.kind == "srv":
-        base = _service_base(base)
+    base = base_name(name.name, name.kind)
     package = search_path.find_package(name.package)
     return package.path / name.kind / f"{base}.{name.kind}"
 
@@ -60,8 +69,10 @@ def list_types(package: str, kind: str) -> list[str]:
     return sorted(p.stem for p in folder.glob(f"*.{kind}") if p.is_file())
 
 
-def load_spec(type_name: str) -> MessageSpec | ServiceSpec:
+def load_spec(type_name: str) -> Spec:
     """Parse the definition of a canonical type name (cached).
+
+    An action's generated types (``pkg/action/Name_SendGoal``...) come from its file.
 
     Raises:
         InterfaceError: unknown package or type (with close names), or a bad file.
@@ -74,6 +85,13 @@ def load_spec(type_name: str) -> MessageSpec | ServiceSpec:
         service = load_spec(f"{name.package}/srv/{_service_base(name.name)}")
         assert isinstance(service, ServiceSpec)
         return service.request if name.name.endswith("_Request") else service.response
+    if name.kind == "action" and name.name != base_name(name.name, "action"):
+        from rosl.idl.action_types import derived_spec
+
+        base = base_name(name.name, "action")
+        action = load_spec(f"{name.package}/action/{base}")
+        assert isinstance(action, ActionSpec)
+        return derived_spec(action, name.name[len(base) :])
     with _lock:
         if key in _specs:
             return _specs[key]
@@ -85,11 +103,11 @@ def load_spec(type_name: str) -> MessageSpec | ServiceSpec:
         except (OSError, UnicodeDecodeError) as err:
             raise InterfaceError(f"cannot read {name}: {err}", path) from None
         if name.kind == "msg":
-            spec: MessageSpec | ServiceSpec = parse_message(text, key, path)
+            spec: Spec = parse_message(text, key, path)
         elif name.kind == "srv":
             spec = parse_service(text, key, path)
         else:
-            raise InterfaceError(f"{key}: actions are not supported yet", path)
+            spec = parse_action(text, key, path)
         _specs[key] = spec
         return spec
 
@@ -193,6 +211,8 @@ def get_message_class(type_name: str) -> type[Message]:
         spec = load_spec(key)
         if isinstance(spec, ServiceSpec):
             raise InterfaceError(f"'{key}' is a service; use '{key}' with a service API")
+        if isinstance(spec, ActionSpec):
+            raise InterfaceError(f"'{key}' is an action; use '{key}' with an action API")
         _loading.append(key)
         try:
             return _build(resolve(spec))
@@ -231,14 +251,15 @@ def get_service_class(type_name: str) -> type[ServiceType]:
         return cls
 
 
-def get_interface(type_name: str) -> type[Message] | type[ServiceType]:
+def get_interface(type_name: str) -> type[Message] | type[ServiceType] | type[ActionType]:
     """Return the class for a message or service type name.
 
     Args:
         type_name: ``pkg/msg/Name``, ``pkg/srv/Name`` or ``pkg/Name`` (a message if both exist).
 
     Returns:
-        A message class, or a service class with ``Request`` and ``Response``.
+        A message class, a service class with ``Request`` and ``Response``, or an action
+        class.
 
     Raises:
         InterfaceError: unknown or badly defined type.
@@ -253,7 +274,44 @@ def get_interface(type_name: str) -> type[Message] | type[ServiceType]:
             pass
     if name.kind == "srv" and not name.name.endswith(("_Request", "_Response")):
         return get_service_class(str(name))
+    if name.kind == "action" and name.name == base_name(name.name, "action"):
+        return get_action_class(str(name))
+    if name.kind == "action" and name.name.endswith(("_SendGoal", "_GetResult")):
+        return get_service_class(str(name))
     return get_message_class(str(name))
+
+
+def get_action_class(type_name: str) -> type[ActionType]:
+    """Return the class of an action type, as rosidl_generator_py makes it (built on first use).
+
+    It holds ``Goal``, ``Result``, ``Feedback`` and ``Impl`` (``SendGoalService``,
+    ``GetResultService``, ``FeedbackMessage``, ``CancelGoalService``, ``GoalStatusMessage``).
+
+    Raises:
+        InterfaceError: unknown or badly defined action (or a type it uses).
+    """
+    key = str(parse_type_name(type_name, "action"))
+    cached = _actions.get(key)
+    if cached is not None:
+        return cached
+    with _lock:
+        spec = load_spec(key)
+        if not isinstance(spec, ActionSpec):
+            raise InterfaceError(f"'{key}' is not an action")
+        from rosl.idl.messages import build_action_class
+
+        cls = build_action_class(
+            key,
+            {
+                part: get_message_class(f"{key}{part}")
+                for part in ("_Goal", "_Result", "_Feedback", "_FeedbackMessage")
+            },
+            {part: get_service_class(f"{key}{part}") for part in ("_SendGoal", "_GetResult")},
+            get_service_class("action_msgs/srv/CancelGoal"),
+            get_message_class("action_msgs/msg/GoalStatusArray"),
+        )
+        _actions[key] = cls
+        return cls
 
 
 KINDS = ("msg", "srv", "action")
@@ -298,6 +356,7 @@ def clear() -> None:
         _specs.clear()
         _classes.clear()
         _services.clear()
+        _actions.clear()
         _store = None
     search_path.rescan()
     for hook in _clear_hooks:
@@ -369,7 +428,7 @@ def schema(type_name: str) -> tuple[str, str]:
     rosbags and by Foxglove (its ros2idl parser); mcap-ros2-support (0.6) decodes ros2msg only
     and leaves these topics undecoded.
     """
-    if "/srv/" in type_name:
+    if "/srv/" in type_name or "/action/" in type_name:  # an action's feedback: the same
         from rosl.idl.idl_text import full_idl
 
         return "ros2idl", full_idl(type_name)

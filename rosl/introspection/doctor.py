@@ -177,27 +177,31 @@ def _packages(result: Diagnosis, session: Session, domain: int | None) -> CheckR
 def _interfaces(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:
     from rosl.idl import registry
     from rosl.idl.errors import InterfaceError
-    from rosl.idl.parser import ServiceSpec
+    from rosl.idl.parser import ActionSpec, MessageSpec, ServiceSpec
 
     del session, domain
     checked, errors = 0, []
     for package in sorted(result.search.packages if result.search else ()):
-        for kind in ("msg", "srv"):
+        for kind in ("msg", "srv", "action"):
             for name in registry.list_types(package, kind):
                 checked += 1
                 try:
                     spec = registry.load_spec(f"{package}/{kind}/{name}")
-                    halves = (
-                        (spec.request, spec.response) if isinstance(spec, ServiceSpec) else (spec,)
-                    )
+                    halves: tuple[MessageSpec, ...]
+                    if isinstance(spec, ActionSpec):
+                        halves = spec.parts
+                    elif isinstance(spec, ServiceSpec):
+                        halves = (spec.request, spec.response)
+                    else:
+                        halves = (spec,)
                     for half in halves:
                         registry.resolve(half)
                 except InterfaceError as err:
                     errors.append(err.render())
     if errors:
-        summary = f"{len(errors)} of {checked} .msg/.srv files have errors"
+        summary = f"{len(errors)} of {checked} .msg/.srv/.action files have errors"
         return CheckResult("interface", False, summary, details=_first(tuple(errors)))
-    return CheckResult("interface", True, f"{checked} .msg/.srv files parse")
+    return CheckResult("interface", True, f"{checked} .msg/.srv/.action files parse")
 
 
 def _nodes(result: Diagnosis, session: Session, domain: int | None) -> CheckResult:

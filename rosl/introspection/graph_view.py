@@ -2,6 +2,8 @@
 
 Unlike rqt_graph, everything is shown by default: a topic nobody subscribes to is drawn and
 labelled ``dead sink``, one with a single connection ``leaf``. The hide filters are opt-in.
+An action is drawn once (action clients -> action -> servers), as rqt_graph's "Actions" group
+draws its hidden ``_action/`` topics as one box.
 The model is plain data (:class:`GraphModel`); the renderers are pure functions of it, sorted,
 so the same graph always gives the same text.
 """
@@ -14,6 +16,7 @@ import subprocess
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
+from rosl.graph import actions
 from rosl.graph.records import CLIENT, PUBLISHER, SUBSCRIPTION, is_hidden
 from rosl.introspection.errors import IntrospectionError
 
@@ -77,10 +80,10 @@ class GraphOptions:
 
 @dataclass(frozen=True, slots=True)
 class Channel:
-    """A topic (publishers → subscribers) or a service (clients → servers) in the picture."""
+    """A topic (publishers → subscribers), a service or an action (clients → servers)."""
 
     name: str
-    kind: str  # "topic" or "service"
+    kind: str  # "topic", "service" or "action"
     types: tuple[str, ...]
     sources: tuple[str, ...]  # node names: publishers or clients
     sinks: tuple[str, ...]  # node names: subscribers or servers
@@ -106,6 +109,11 @@ class GraphModel:
         """The services, sorted by name."""
         return [c for c in self.channels if c.kind == "service"]
 
+    @property
+    def actions(self) -> list[Channel]:
+        """The actions, sorted by name."""
+        return [c for c in self.channels if c.kind == "action"]
+
 
 # --- the model -------------------------------------------------------------------------------
 
@@ -128,6 +136,11 @@ def build(graph: GraphCache, options: GraphOptions, own_process: int | None = No
             types, sources, sinks = ends.setdefault((endpoint.name, kind), (set(), set(), set()))
             types.add(endpoint.type)
             (sources if endpoint.kind in (PUBLISHER, CLIENT) else sinks).add(node.fqn)
+        for side, named in ((1, actions.clients(node)), (2, actions.servers(node))):
+            for name, action_types in named.items():
+                sets = ends.setdefault((name, "action"), (set(), set(), set()))
+                sets[0].update(action_types)
+                sets[side].add(node.fqn)
     channels = tuple(_channel(name, kind, *sets) for (name, kind), sets in sorted(ends.items()))
     return _filtered(GraphModel(dict(sorted(nodes.items())), channels), options)
 
@@ -141,6 +154,8 @@ def _channel(name: str, kind: str, types: set[str], sources: set[str], sinks: se
             marks.append("leaf")
     elif not sinks:
         marks.append("no server")
+    elif kind == "action" and not sources:
+        marks.append("no client")
     if len(types) > 1:
         marks.append(f"{len(types)} types")
     if is_hidden(name):
@@ -261,27 +276,34 @@ def _pairs(m: GraphModel, kind: str) -> dict[tuple[str, str], list[str]]:
     return dict(sorted(pairs.items()))
 
 
+_PREFIX = {"topic": "t:", "service": "s:", "action": "a:"}
+_SHAPES = {"topic": "box", "service": "diamond", "action": "hexagon"}
+
+
 def to_dot(m: GraphModel, nodes_only: bool = False) -> str:
-    """The picture as Graphviz DOT (node ids ``n:``, topics ``t:``, services ``s:``)."""
+    """The picture as Graphviz DOT (node ids ``n:``, topics ``t:``, services ``s:``, ``a:``)."""
     out = ["digraph rosgraph {", "  rankdir=LR;", "  node [fontsize=10];"]
     for node in m.nodes:
         out.append(
             f"  {_q('n:' + node)} [label={_q(*_node_label(m, node, nodes_only))}, shape=ellipse];"
         )
     if nodes_only:
-        for kind, style in (("topic", ""), ("service", ", style=dashed")):
+        for kind, style in (
+            ("topic", ""),
+            ("service", ", style=dashed"),
+            ("action", ", style=bold"),
+        ):
             for (src, dst), names in _pairs(m, kind).items():
                 out.append(f"  {_q('n:' + src)} -> {_q('n:' + dst)} [label={_q(*names)}{style}];")
         return "\n".join([*out, "}"]) + "\n"
     for c in m.channels:
-        ident = _q(("t:" if c.kind == "topic" else "s:") + c.name)
-        shape = "box" if c.kind == "topic" else "diamond"
+        ident = _q(_PREFIX[c.kind] + c.name)
         loose = {"dead sink", "no server"} & set(c.marks)
         color = ', color="red"' if loose else ', color="orange"' if "leaf" in c.marks else ""
-        out.append(f"  {ident} [label={_q(*_label(c))}, shape={shape}{color}];")
+        out.append(f"  {ident} [label={_q(*_label(c))}, shape={_SHAPES[c.kind]}{color}];")
     for c in m.channels:
-        ident = _q(("t:" if c.kind == "topic" else "s:") + c.name)
-        style = "" if c.kind == "topic" else " [style=dashed]"
+        ident = _q(_PREFIX[c.kind] + c.name)
+        style = {"topic": "", "service": " [style=dashed]", "action": " [style=bold]"}[c.kind]
         out += [f"  {_q('n:' + src)} -> {ident}{style};" for src in c.sources]
         out += [f"  {ident} -> {_q('n:' + dst)}{style};" for dst in c.sinks]
     return "\n".join([*out, "}"]) + "\n"
@@ -297,19 +319,22 @@ def to_mermaid(m: GraphModel, nodes_only: bool = False) -> str:
     out = ["flowchart LR"]
     out += [f"  {ids['node', n]}([{_mq(_node_label(m, n, nodes_only))}])" for n in m.nodes]
     if nodes_only:
-        for kind, arrow in (("topic", "-->"), ("service", "-.->")):
+        for kind, arrow in (("topic", "-->"), ("service", "-.->"), ("action", "==>")):
             for (src, dst), names in _pairs(m, kind).items():
                 out.append(f"  {ids['node', src]} {arrow}|{_mq(names)}| {ids['node', dst]}")
         return "\n".join(out) + "\n"
     warned = []
     for i, c in enumerate(m.channels, 1):
-        ident = ids[c.kind, c.name] = ("t" if c.kind == "topic" else "s") + str(i)
+        ident = ids[c.kind, c.name] = c.kind[0] + str(i)
         text = _mq(_label(c))
-        out.append(f"  {ident}[{text}]" if c.kind == "topic" else f"  {ident}{{{text}}}")
+        opening, closing = {"topic": ("[", "]"), "service": ("{", "}"), "action": ("{{", "}}")}[
+            c.kind
+        ]
+        out.append(f"  {ident}{opening}{text}{closing}")
         if {"dead sink", "no server", "leaf"} & set(c.marks):
             warned.append(ident)
     for c in m.channels:
-        arrow = "-->" if c.kind == "topic" else "-.->"
+        arrow = {"topic": "-->", "service": "-.->", "action": "==>"}[c.kind]
         out += [f"  {ids['node', s]} {arrow} {ids[c.kind, c.name]}" for s in c.sources]
         out += [f"  {ids[c.kind, c.name]} {arrow} {ids['node', d]}" for d in c.sinks]
     if warned:
@@ -330,6 +355,8 @@ def to_text(m: GraphModel) -> str:
         ("subscribes", "topic", "sinks", "sources", "<-", "nobody"),
         ("serves", "service", "sinks", "sources", "<-", "no client"),
         ("calls", "service", "sources", "sinks", "->", "no server"),
+        ("serves actions", "action", "sinks", "sources", "<-", "no client"),
+        ("sends goals", "action", "sources", "sinks", "->", "no server"),
     )
     for node in m.nodes:
         out.append(_node_label(m, node, False)[0])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from rosl.graph import actions
 from rosl.graph.records import CLIENT, PUBLISHER, SERVER, SUBSCRIPTION
 from rosl.introspection.errors import IntrospectionError
 from rosl.introspection.session import visible
@@ -32,6 +33,8 @@ def node_info(
     session: Session, name: str, *, include_hidden: bool = False
 ) -> tuple[list[str], list[str]]:
     """(stdout lines, stderr lines) of ``ros2 node info NODE``: the six sections.
+
+    Actions are found by their feedback topics (hidden names, so not in the topic sections).
 
     As ros2: a hidden node is only found with ``include_hidden``.
 
@@ -62,7 +65,14 @@ def node_info(
             if endpoint.kind == kind and visible(endpoint.name, include_hidden):
                 entries.setdefault(endpoint.name, set()).add(endpoint.type)
         lines += [f"    {n}: {', '.join(sorted(t))}" for n, t in sorted(entries.items())]
-    lines += ["  Action Servers:", "  Action Clients:", ""]
+    for title, named in (
+        ("Action Servers", actions.servers(node)),
+        ("Action Clients", actions.clients(node)),
+    ):
+        lines.append(f"  {title}:")
+        lines += [
+            f"    {n}: {', '.join(t)}" for n, t in named.items() if visible(n, include_hidden)
+        ]
     return _blank_empty_sections(lines), warnings
 
 

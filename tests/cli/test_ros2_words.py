@@ -55,14 +55,9 @@ def test_wtf_is_doctor(processes: Processes) -> None:
 @pytest.mark.parametrize(
     ("words", "line"),
     [
-        (["action", "list"], "rosl action list: actions are not in rosl yet"),
-        (
-            ["action", "send_goal", "/fibonacci", "action_tutorials_interfaces/action/Fibonacci"],
-            "rosl action send_goal: actions are not in rosl yet",
-        ),
         (["component", "list"], "rosl component list: components are not in rosl"),
     ],
-    ids=["action-list", "action-send-goal", "component-list"],
+    ids=["component-list"],
 )
 def test_commands_not_there_yet_say_so_in_one_line_and_fail(
     processes: Processes, words: list[str], line: str

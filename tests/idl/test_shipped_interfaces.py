@@ -60,6 +60,7 @@ def shipped(kind: str) -> list[str]:
 # rosbags has no example_interfaces: tests/idl/test_example_interfaces.py checks its messages
 MESSAGES = [m for m in shipped("msg") if not m.startswith("example_interfaces/")]
 SERVICES = shipped("srv")
+ACTIONS = shipped("action")
 
 
 def reference(type_name: str):
@@ -102,6 +103,19 @@ def test_shipped_service_parses_and_resolves(type_name):
         assert store.deserialize(data, half.__msgtype__) == half
 
 
+@pytest.mark.parametrize("type_name", ACTIONS)
+def test_shipped_action_parses_and_its_generated_types_round_trip(type_name):
+    action = registry.get_action_class(type_name)
+    impl = action.Impl
+    store = registry.store()
+    for message in (
+        action.Goal(), action.Result(), action.Feedback(), impl.FeedbackMessage(),
+        impl.SendGoalService.Request(), impl.SendGoalService.Response(),
+        impl.GetResultService.Request(), impl.GetResultService.Response(),
+    ):  # fmt: skip
+        assert store.deserialize(store.serialize(message), message.__msgtype__) == message
+
+
 def test_parameter_service_fields_match_ros2():
     get = registry.get_service_class("rcl_interfaces/srv/GetParameters")
     assert get.Request._fields == ("names",)
@@ -113,7 +127,7 @@ def test_parameter_service_fields_match_ros2():
 
 def test_shipped_files_carry_our_own_header_comment():
     for path in sorted(INTERFACES.glob("*/*/*.*")):
-        if path.suffix in (".msg", ".srv"):
+        if path.suffix in (".msg", ".srv", ".action"):
             first = path.read_text().splitlines()[0]
             assert first.startswith("#"), path
 

@@ -227,3 +227,50 @@ def test_mermaid_and_text_show_the_same_picture() -> None:
     assert "/listener\n  subscribes:\n    /chatter [std_msgs/msg/String] <- /talker\n" in text
     assert "    /cmd_vel [geometry_msgs/msg/Twist] -> nobody [dead sink, leaf]" in text
     assert graph_view.to_text(build(GraphCache(), GraphOptions())) == "(no nodes)\n"
+
+
+FIB = "example_interfaces/action/Fibonacci"
+
+
+def action_graph() -> GraphCache:
+    """An action server and a client of /fibonacci, with the endpoints ROS 2 makes for it."""
+    base = "/fibonacci/_action/"
+    server = [
+        (SERVER, base + "send_goal", FIB + "_SendGoal"),
+        (SERVER, base + "cancel_goal", "action_msgs/srv/CancelGoal"),
+        (SERVER, base + "get_result", FIB + "_GetResult"),
+        (PUBLISHER, base + "feedback", FIB + "_FeedbackMessage"),
+        (PUBLISHER, base + "status", "action_msgs/msg/GoalStatusArray"),
+    ]
+    client = [
+        (CLIENT, base + "send_goal", FIB + "_SendGoal"),
+        (SUBSCRIPTION, base + "feedback", FIB + "_FeedbackMessage"),
+        (SUBSCRIPTION, base + "status", "action_msgs/msg/GoalStatusArray"),
+    ]
+    return graph_of(make_node("/fib_server", 1, *server), make_node("/fib_client", 2, *client))
+
+
+def test_an_action_is_drawn_once_from_its_clients_to_its_servers() -> None:
+    model = build(action_graph(), GraphOptions())
+
+    (action,) = model.actions
+    assert (action.name, action.types) == ("/fibonacci", (FIB,))
+    assert (action.sources, action.sinks, action.marks) == (("/fib_client",), ("/fib_server",), ())
+    assert not [c for c in model.channels if "_action" in c.name]  # its topics stay hidden
+    dot = graph_view.to_dot(model)
+    assert '"a:/fibonacci" [label="/fibonacci", shape=hexagon];' in dot
+    assert '"n:/fib_client" -> "a:/fibonacci" [style=bold];' in dot
+    assert '"a:/fibonacci" -> "n:/fib_server" [style=bold];' in dot
+    text = graph_view.to_text(model)
+    assert f"  serves actions:\n    /fibonacci [{FIB}] <- /fib_client\n" in text
+    assert f"  sends goals:\n    /fibonacci [{FIB}] -> /fib_server\n" in text
+    assert 'a1{{"/fibonacci"}}' in graph_view.to_mermaid(model)
+
+
+def test_an_action_nobody_serves_is_marked() -> None:
+    graph = action_graph()
+    graph.remove(1)
+
+    (action,) = build(graph, GraphOptions()).actions
+
+    assert action.marks == ("no server",)

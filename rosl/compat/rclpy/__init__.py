@@ -36,6 +36,7 @@ __all__ = [
 
 _SUBMODULES = frozenset(
     (
+        "action",
         "callback_groups",
         "client",
         "clock",
