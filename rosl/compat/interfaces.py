@@ -69,9 +69,11 @@ class _Loader(importlib.abc.Loader):
         return None
 
 
-def _is_interface_package(name: str) -> bool:
+def _is_interface_package(name: str, kind: str | None) -> bool:
+    """Whether ``name`` has interfaces (of ``kind``: no ``std_msgs.srv`` module, as in ROS 2)."""
     found = search_path.scan().packages.get(name)  # a miss is common here: no error built
-    return found is not None and any((found.path / kind).is_dir() for kind in _KINDS)
+    kinds = _KINDS if kind is None else (kind,)
+    return found is not None and any((found.path / k).is_dir() for k in kinds)
 
 
 def _is_real(spec: importlib.machinery.ModuleSpec | None) -> bool:
@@ -99,7 +101,7 @@ class InterfaceFinder(importlib.abc.MetaPathFinder):
         try:
             if _is_real(importlib.machinery.PathFinder.find_spec(fullname, path)):
                 return None
-            if not _is_interface_package(parts[0]):
+            if not _is_interface_package(parts[0], parts[1] if len(parts) == 2 else None):
                 return None
         finally:
             _busy.active = False
