@@ -12,6 +12,12 @@ Modes: paced at ``real_time_factor`` x wall time (default 1); ``fast``: lock-ste
 next step, so the run does not depend on the machine's speed. Within a step the sensor
 messages go out before ``/clock``, so a timer woken by the new time sees the step's data.
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
+
+Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
+small messages join their topic's batch, sent at most a millisecond of wall time later and
+before the node sleeps, and the bus is served at most every millisecond rather than every
+step: a datagram per step per topic would cost more than the physics. Lock-step and recording
+keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
@@ -37,6 +43,7 @@ if TYPE_CHECKING:
     from rosl.sim.simulation import SimRobot, Simulation
 
 NS = 1_000_000_000
+SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
 
 
 class _Topic:
@@ -46,14 +53,16 @@ class _Topic:
         self.sim_node = sim_node
         self.publisher = publisher
         self.always = always
+        self._publish = publisher.publish
 
     def wanted(self) -> bool:
         return self.always or self.sim_node.subscribed(self.publisher.topic)
 
     def send(self, message: Any) -> None:
-        self.publisher.publish(message)
-        if self.sim_node.lockstep is not None:
-            self.sim_node.lockstep.published(self.publisher)
+        self._publish(message)
+        lockstep = self.sim_node.lockstep
+        if lockstep is not None:
+            lockstep.published(self.publisher)
 
 
 @dataclass(slots=True)
@@ -97,15 +106,23 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
+        self._serve_at = 0.0  # paced: when the bus is next looked at (time.monotonic())
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self._batched = not options.fast and options.record is None
+        batched = self._batched
         self.clock = _Topic(
             self,
-            node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
+            node.create_publisher(
+                build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10, coalesce=batched
+            ),
             always=True,
         )
         self.tf = _Topic(
-            self, node.create_publisher(build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100)
+            self,
+            node.create_publisher(
+                build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100, coalesce=batched
+            ),
         )
         self.tf_static = node.create_publisher(
             build.msg("tf2_msgs/msg/TFMessage"), "/tf_static", latched
@@ -124,7 +141,10 @@ class SimNode:
             odom = _Topic(
                 self,
                 node.create_publisher(
-                    build.msg("nav_msgs/msg/Odometry"), f"{prefix}/{model.odom_topic}", 10
+                    build.msg("nav_msgs/msg/Odometry"),
+                    f"{prefix}/{model.odom_topic}",
+                    10,
+                    coalesce=batched,
                 ),
             )
             joints = None
@@ -135,6 +155,7 @@ class SimNode:
                         build.msg("sensor_msgs/msg/JointState"),
                         f"{prefix}/{model.joint_states_topic}",
                         10,
+                        coalesce=batched,
                     ),
                 )
             scans = [
@@ -144,6 +165,7 @@ class SimNode:
                         build.msg("sensor_msgs/msg/LaserScan"),
                         f"{prefix}/{lidar.topic}",
                         qos_profile_sensor_data,
+                        coalesce=batched,
                     ),
                 )
                 for lidar in model.lidars
@@ -261,17 +283,19 @@ class SimNode:
         status_at = started + 1.0
         live = not options.headless and sys.stderr.isatty()
         self.tick()
+        sim, tick, settle = self.sim, self.tick, self._settle
         while context.ok():
-            self._settle()
-            if end_ns is not None and self.sim.now_ns >= end_ns:
+            settle()
+            if end_ns is not None and sim.now_ns >= end_ns:
                 break
             if not options.fast:
                 self._pace(started)
-            self.sim.step()
-            self.tick()
+            sim.step()
+            tick()
             if live and time.monotonic() >= status_at:
                 status_at += 1.0
                 self._status(started)
+        participant.flush()  # what the batches still hold
         wall = time.monotonic() - started
         if live:
             sys.stderr.write("\n")
@@ -279,6 +303,13 @@ class SimNode:
 
     def _settle(self) -> None:
         """After a step's messages went out: wait (lock-step) and record."""
+        if self._batched:  # paced: the bus is looked at every millisecond, not every step
+            now = time.monotonic()
+            if now < self._serve_at:
+                return
+            self._serve_at = now + SERVE_EVERY_S
+            self.executor.spin_some()
+            return
         replies: list[tuple[int, int, int, int]] = []
         if self.lockstep is not None:
             replies = self.lockstep.wait(self.sim.now_ns)
@@ -311,10 +342,14 @@ class SimNode:
         """Real-time factor pacing: serve the bus until the next step is due in wall time."""
         factor = self.options.real_time_factor
         due = started + (self.sim.now_ns + self.sim.step_ns) / NS / factor
+        flushed = False
         while self.node.context.ok():
             remaining = due - time.monotonic()
             if remaining <= 0:
                 return
+            if not flushed:  # about to wait: what the batches hold goes out now
+                self.node.participant.flush()
+                flushed = True
             self.executor.spin_once(remaining)
 
     def _wait_for_peers(self) -> None:

@@ -77,6 +77,8 @@ class Simulation:
         self.seed = world.seed if seed is None else seed
         self.space = WorldSpace(world)
         self.step_ns = world.step_ns
+        self._dt = self.step_ns / NS
+        self._space_step = self.space.space.step
         self.now_ns = 0
         self.steps = 0
         self.robots: list[SimRobot] = []
@@ -105,15 +107,17 @@ class Simulation:
 
     def step(self) -> None:
         """Advance the physics by one fixed step."""
-        dt = self.step_ns / NS
-        for sim_robot in self.robots:
+        dt = self._dt
+        robots = self.robots
+        for sim_robot in robots:
             sim_robot.robot.before_step(dt)
-        self.space.space.step(dt)
+        self._space_step(dt)
         self.now_ns += self.step_ns
         self.steps += 1
-        for sim_robot in self.robots:
-            sim_robot.robot.after_step(dt)
-            x, y, _ = sim_robot.robot.pose
+        for sim_robot in robots:
+            robot = sim_robot.robot
+            robot.after_step(dt)
+            x, y, _ = robot.pose
             lx, ly = sim_robot.last_xy
             sim_robot.distance += math.hypot(x - lx, y - ly)
             sim_robot.last_xy = (x, y)
