@@ -64,6 +64,10 @@ class _Topic:
         if lockstep is not None:
             lockstep.published(self.publisher)
 
+    def free(self) -> None:
+        """No lock-step: sending is publishing, one call less per message."""
+        self.send = self._publish  # type: ignore[method-assign,assignment]
+
 
 @dataclass(slots=True)
 class _RobotTopics:
@@ -72,6 +76,7 @@ class _RobotTopics:
     joints: _Topic | None
     scans: list[_Topic]
     description: Publisher
+    encoder: build.RobotEncoder
 
 
 class SimNode:
@@ -173,7 +178,11 @@ class SimNode:
             description = node.create_publisher(
                 build.msg("std_msgs/msg/String"), f"{prefix}/robot_description", latched
             )
-            self.robots.append(_RobotTopics(sim_robot, odom, joints, scans, description))
+            self.robots.append(
+                _RobotTopics(
+                    sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
+                )
+            )
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -226,26 +235,28 @@ class SimNode:
         transforms: list[build.Transform] = []
         for topics in self.robots:
             sim_robot = topics.sim_robot
+            encoder = topics.encoder
             if sim_robot.odom.due(now):
                 sim_robot.odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
+                odom = sim_robot.robot.odometry()
                 if topics.odom.wanted():
-                    topics.odom.send(build.odometry_bytes(sim_robot, now))
-                transforms.append(build.odom_transform(sim_robot))
+                    topics.odom.send(encoder.odometry(now, odom))
+                transforms.append(encoder.odom_transform(odom))
             if sim_robot.joints is not None and sim_robot.joints.due(now):
                 sim_robot.joints.fire(now)
                 if topics.joints is not None and topics.joints.wanted():
-                    topics.joints.send(build.joint_states_bytes(sim_robot, now))
-                transforms += build.wheel_transforms(sim_robot)
+                    topics.joints.send(encoder.joint_states(now))
+                transforms += encoder.wheel_transforms()
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
                 if schedule.due(now):
                     index = schedule.fire(now)
                     if topic.wanted() or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if topic.wanted():
-                            topic.send(build.laser_scan_bytes(lidar, ranges, now))
+                            topic.send(encoder.laser_scan(lidar, ranges, now))
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))
         self.clock.send(build.clock_bytes(now))
@@ -267,10 +278,11 @@ class SimNode:
                 on_stall=options.on_stall,
                 log=lambda line: self._logger().warn(line),
             )
-            for publisher in [self.clock, self.tf] + [
-                t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t
-            ]:
-                self.lockstep.mark(publisher.publisher)
+            for topic in self._stepped():
+                self.lockstep.mark(topic.publisher)
+        else:
+            for topic in self._stepped():
+                topic.free()
         self.publish_static()
         self._announce()
         self._wait_for_peers()
@@ -300,6 +312,12 @@ class SimNode:
         if live:
             sys.stderr.write("\n")
         return self._finish(wall)
+
+    def _stepped(self) -> list[_Topic]:
+        """The topics published as the simulation steps."""
+        return [self.clock, self.tf] + [
+            t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t
+        ]
 
     def _settle(self) -> None:
         """After a step's messages went out: wait (lock-step) and record."""

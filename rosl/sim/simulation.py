@@ -36,15 +36,23 @@ class Schedule:
 
     rate: float
     index: int = 0  # the next firing's k
+    at_ns: float = field(init=False)  # when it is due (inf: never), kept by fire()
+
+    def __post_init__(self) -> None:
+        self.at_ns = self._at(self.index)
+
+    def _at(self, index: int) -> float:
+        return round(index * NS / self.rate) if self.rate > 0 else math.inf
 
     def due(self, now_ns: int) -> bool:
         """Whether the next firing is due at ``now_ns``."""
-        return self.rate > 0 and now_ns >= round(self.index * NS / self.rate)
+        return now_ns >= self.at_ns
 
     def fire(self, now_ns: int) -> int:
         """Take the due firing; return its k. Firings missed in one step are skipped."""
         index = self.index
         self.index = max(index + 1, math.floor(now_ns * self.rate / NS) + 1)
+        self.at_ns = self._at(self.index)
         return index
 
 
