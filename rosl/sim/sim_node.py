@@ -14,14 +14,16 @@ messages go out before ``/clock``, so a timer woken by the new time sees the ste
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
 
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
-small messages join their topic's batch, sent at most a millisecond of wall time later and
-before the node sleeps, and the bus is served at most every millisecond rather than every
-step: a datagram per step per topic would cost more than the physics. Lock-step and recording
+small messages join their topic's batch, which this thread sends once a millisecond of wall
+time and before it sleeps (sensors first, ``/clock`` last; no timer thread contends for the
+GIL), and the bus is served at that pace rather than every step: a datagram per step per topic
+would cost more than the physics. Lock-step and recording
 keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass
@@ -111,23 +113,18 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
-        self._serve_at = 0.0  # paced: when the bus is next looked at (time.monotonic())
+        self._next_event = 0.0  # sim ns of the next sensor or odometry firing
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._batched = not options.fast and options.record is None
-        batched = self._batched
         self.clock = _Topic(
             self,
-            node.create_publisher(
-                build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10, coalesce=batched
-            ),
+            node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
             always=True,
         )
         self.tf = _Topic(
             self,
-            node.create_publisher(
-                build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100, coalesce=batched
-            ),
+            node.create_publisher(build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100),
         )
         self.tf_static = node.create_publisher(
             build.msg("tf2_msgs/msg/TFMessage"), "/tf_static", latched
@@ -149,7 +146,6 @@ class SimNode:
                     build.msg("nav_msgs/msg/Odometry"),
                     f"{prefix}/{model.odom_topic}",
                     10,
-                    coalesce=batched,
                 ),
             )
             joints = None
@@ -160,7 +156,6 @@ class SimNode:
                         build.msg("sensor_msgs/msg/JointState"),
                         f"{prefix}/{model.joint_states_topic}",
                         10,
-                        coalesce=batched,
                     ),
                 )
             scans = [
@@ -170,7 +165,6 @@ class SimNode:
                         build.msg("sensor_msgs/msg/LaserScan"),
                         f"{prefix}/{lidar.topic}",
                         qos_profile_sensor_data,
-                        coalesce=batched,
                     ),
                 )
                 for lidar in model.lidars
@@ -231,6 +225,9 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
+        if now < self._next_event:  # most steps: only the time moves on
+            self._send_clock(build.clock_bytes(now))
+            return
         sampled = False
         transforms: list[build.Transform] = []
         for topics in self.robots:
@@ -260,6 +257,15 @@ class SimNode:
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))
         self.clock.send(build.clock_bytes(now))
+        self._next_event = min(
+            [r.odom.at_ns for r in sim.robots]
+            + [r.joints.at_ns for r in sim.robots if r.joints is not None]
+            + [schedule.at_ns for r in sim.robots for _, schedule in r.lidars],
+            default=math.inf,
+        )
+
+    def _send_clock(self, data: bytes) -> None:
+        self.clock.send(data)
 
     # --- running -----------------------------------------------------------------------------
 
@@ -283,6 +289,10 @@ class SimNode:
         else:
             for topic in self._stepped():
                 topic.free()
+            self._send_clock = self.clock.send  # type: ignore[method-assign,assignment]
+        if self._batched:
+            for topic in self._stepped():
+                topic.publisher.hold_until_flush()
         self.publish_static()
         self._announce()
         self._wait_for_peers()
@@ -295,23 +305,57 @@ class SimNode:
         status_at = started + 1.0
         live = not options.headless and sys.stderr.isatty()
         self.tick()
-        sim, tick, settle = self.sim, self.tick, self._settle
-        while context.ok():
-            settle()
-            if end_ns is not None and sim.now_ns >= end_ns:
-                break
-            if not options.fast:
-                self._pace(started)
-            sim.step()
-            tick()
-            if live and time.monotonic() >= status_at:
-                status_at += 1.0
-                self._status(started)
-        participant.flush()  # what the batches still hold
+        if self._batched:
+            self._run_paced(started, end_ns, live)
+        else:
+            sim, tick, settle = self.sim, self.tick, self._settle
+            while context.ok():
+                settle()
+                if end_ns is not None and sim.now_ns >= end_ns:
+                    break
+                if not options.fast:
+                    self._pace(started)
+                sim.step()
+                tick()
+                if live and time.monotonic() >= status_at:
+                    status_at += 1.0
+                    self._status(started)
+        self._flush()  # what the batches still hold
         wall = time.monotonic() - started
         if live:
             sys.stderr.write("\n")
         return self._finish(wall)
+
+    def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
+        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
+        sim, tick, step = self.sim, self.tick, self.sim.step
+        context, monotonic = self.node.context, time.monotonic
+        scale = NS * self.options.real_time_factor  # sim ns per wall second
+        status_at = started + 1.0
+        serve_at = 0.0
+        while True:
+            wall = monotonic()
+            if wall >= serve_at:
+                self._flush()
+                if not context.ok():
+                    return
+                self.executor.spin_some()  # /cmd_vel, parameters
+                serve_at = wall + SERVE_EVERY_S
+                if live and wall >= status_at:
+                    status_at += 1.0
+                    self._status(started)
+            if end_ns is not None and sim.now_ns >= end_ns:
+                return
+            if started + (sim.now_ns + sim.step_ns) / scale > wall:
+                self._pace(started)
+            step()
+            tick()
+
+    def _flush(self) -> None:
+        """Paced: send what the batches hold, the sensors' first and ``/clock`` last."""
+        if self._batched:
+            for topic in reversed(self._stepped()):
+                topic.publisher.flush()
 
     def _stepped(self) -> list[_Topic]:
         """The topics published as the simulation steps."""
@@ -321,13 +365,6 @@ class SimNode:
 
     def _settle(self) -> None:
         """After a step's messages went out: wait (lock-step) and record."""
-        if self._batched:  # paced: the bus is looked at every millisecond, not every step
-            now = time.monotonic()
-            if now < self._serve_at:
-                return
-            self._serve_at = now + SERVE_EVERY_S
-            self.executor.spin_some()
-            return
         replies: list[tuple[int, int, int, int]] = []
         if self.lockstep is not None:
             replies = self.lockstep.wait(self.sim.now_ns)
@@ -366,7 +403,7 @@ class SimNode:
             if remaining <= 0:
                 return
             if not flushed:  # about to wait: what the batches hold goes out now
-                self.node.participant.flush()
+                self._flush()
                 flushed = True
             self.executor.spin_once(remaining)
 
