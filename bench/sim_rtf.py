@@ -1,6 +1,6 @@
 """Simulator speed: real-time factor headless, and in lock-step with a controller process.
 
-    .venv/bin/python bench/sim_rtf.py [--seconds 60]
+    .venv/bin/python bench/sim_rtf.py [--seconds 60] [--previous /path/to/older/checkout]
 
 Rows (median of 3):
   core        physics + scans + odometry bookkeeping, no messages (the ceiling)
@@ -10,7 +10,9 @@ Rows (median of 3):
               every scan over the bus (the demo's set-up, recording off)
 Each row prints its real-time factor (sim seconds per wall second) and its ratio to the core
 measured in this run. Targets (issue 7): node >= 200x, node-720 >= 100x, lock-step >= 30x;
-Gazebo runs these worlds at 1x, ir-sim ~2x with a per-step LiDAR.
+Gazebo runs these worlds at 1x, ir-sim ~2x with a per-step LiDAR. Issue 17: node >= 0.7 x
+core, and the core >= 2 x the previous implementation's on the same machine: ``--previous``
+names a checkout of it (a git worktree), whose core runs in a child process in this run.
 """
 
 from __future__ import annotations
@@ -114,11 +116,27 @@ def median(run, *args: object, repeats: int = 3) -> float:
     return statistics.median(run(*args) for _ in range(repeats))
 
 
+def previous_core(tree: Path, seconds: float) -> float:
+    """The core row of another checkout (its rosl first on the path), in a child process."""
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    out = subprocess.run(
+        [sys.executable, __file__, "--seconds", str(seconds), "--core-only"],
+        env=env, capture_output=True, text=True, timeout=600, check=True,
+    ).stdout  # fmt: skip
+    return float(out.split()[-1])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seconds", type=float, default=60.0)
+    parser.add_argument("--previous", type=Path, help="a checkout of the previous implementation")
+    parser.add_argument("--core-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     seconds = args.seconds
+    if args.core_only:
+        print(median(core, seconds))
+        return
+    before = previous_core(args.previous.resolve(), seconds) if args.previous else None
     base = median(core, seconds)
     rows = [
         ("core (5 Hz x 360, no messages)", base, None),
@@ -130,6 +148,10 @@ def main() -> None:
     for name, rtf, target in rows:
         aim = f">={target}x" if target else "-"
         print(f"{name:52} {rtf:7.1f}x {rtf / base:8.2f} {aim:>8}")
+    print(f"node / core: {rows[1][1] / base:.2f} (target >= 0.7); core: {base:.1f}x real time")
+    if before is not None:
+        print(f"core of {args.previous}: {before:.1f}x; this core / that: {base / before:.2f} "
+              "(target >= 2)")  # fmt: skip
 
 
 if __name__ == "__main__":

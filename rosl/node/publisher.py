@@ -3,6 +3,8 @@
 ``coalesce=True`` (or ``ROSL_COALESCE=1`` for every publisher of a process) sends small
 messages in batches of one datagram, at most a millisecond late: several times the messages
 per second of one datagram each, for streams of small messages (see ``rosl/bus/coalesce.py``).
+:meth:`Publisher.hold_until_flush` batches the same way with no timer thread: the caller
+flushes (the simulator does, once a millisecond of wall time).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import os
 import time
 from typing import TYPE_CHECKING
 
+from rosl.bus.coalesce import DEFAULT_BYTES, Flusher
 from rosl.bus.header import Kind
 from rosl.bus.wire import Writer
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
@@ -49,8 +52,6 @@ class Publisher:
         if coalesce is None:
             coalesce = os.environ.get("ROSL_COALESCE", "").strip().lower() in ("1", "true", "yes")
         if coalesce:
-            from rosl.bus.coalesce import DEFAULT_BYTES
-
             self._writer.coalesce(participant.flusher(), DEFAULT_BYTES)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
@@ -122,6 +123,14 @@ class Publisher:
         """Send the messages a coalescing publisher still holds (a no-op otherwise)."""
         self._writer.flush()
 
+    def hold_until_flush(self) -> None:
+        """Batch small messages until :meth:`flush` (or a full batch); no timer sends them.
+
+        For a caller that flushes on its own schedule from its own thread: no second thread
+        wakes every millisecond to contend for the GIL.
+        """
+        self._writer.coalesce(_HeldByCaller(), DEFAULT_BYTES)
+
     def destroy(self) -> None:
         """Stop publishing (rclpy: node.destroy_publisher)."""
         self.node.destroy_publisher(self)
@@ -141,3 +150,12 @@ class Publisher:
         participant.discovery.send(
             {"op": "liveliness", "sender": f"{participant.sender:016x}", "endpoint": self.endpoint}
         )
+
+
+class _HeldByCaller(Flusher):
+    """A flusher that never runs: the publisher's caller sends the batch."""
+
+    def due(self, batch: object) -> bool:
+        """Keep the batch (the caller flushes it)."""
+        del batch
+        return True

@@ -293,42 +293,90 @@ def clock_bytes(now_ns: int) -> bytes:
     return encode.clock(now_ns)
 
 
+Transform = tuple[bytes, bytes, tuple[float, ...]]
+
+
+class RobotEncoder:
+    """One robot's high-rate messages as CDR, with what is fixed about them prepared once.
+
+    Frame names are encoded, the wheel links' fixed rotations and the scans' constant fields
+    computed at construction; a message then costs its moving numbers and one ``pack``.
+    """
+
+    def __init__(self, sim_robot: SimRobot) -> None:
+        self.sim_robot = sim_robot
+        model = sim_robot.robot.spec.model
+        self.odom_frame = model.odom_frame.encode()
+        self.base_frame = model.base_frame.encode()
+        self.joint_names = [j.encode() for j in model.joints]
+        index = {joint: k for k, joint in enumerate(model.joints)}
+        self.wheels = [
+            (frame.parent.encode(), frame.name.encode(), frame.xyz, quaternion(*frame.rpy),
+             index.get(frame.joint))
+            for frame in model.frames
+            if frame.joint is not None
+        ]  # fmt: skip
+        self.scans = {
+            lidar: (lidar.frame_id.encode(),
+                    (lidar.angle_min, lidar.angle_max, lidar_cast.increment(lidar), 0.0,
+                     1.0 / lidar.rate, lidar.range_min, lidar.range_max))
+            for lidar in model.lidars
+        }  # fmt: skip
+
+    def odometry(
+        self, now_ns: int, odom: tuple[tuple[float, float, float], tuple[float, float]]
+    ) -> bytes:
+        """nav_msgs/Odometry of ``odom`` (the robot's :meth:`odometry`) as CDR."""
+        (x, y, yaw), (forward, turn) = odom
+        return encode.odometry(
+            now_ns, self.odom_frame, self.base_frame,
+            (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), _COVARIANCE,
+            (forward, 0.0, 0.0, 0.0, 0.0, turn),
+        )  # fmt: skip
+
+    def odom_transform(self, odom: tuple[tuple[float, float, float], object]) -> Transform:
+        """``odom -> base_footprint`` of ``odom`` (the robot's :meth:`odometry`)."""
+        x, y, yaw = odom[0]
+        return (self.odom_frame, self.base_frame, (x, y, 0.0, *quaternion(0.0, 0.0, yaw)))
+
+    def wheel_transforms(self) -> list[Transform]:
+        """The wheel links turned by their joints."""
+        angles = self.sim_robot.robot.wheels
+        transforms: list[Transform] = []
+        for parent, child, xyz, rotation, joint in self.wheels:
+            spin = 0.0 if joint is None or joint >= len(angles) else angles[joint]
+            if spin:
+                rotation = multiply(rotation, (0.0, 0.0, math.sin(spin / 2), math.cos(spin / 2)))
+            transforms.append((parent, child, (*xyz, *rotation)))
+        return transforms
+
+    def joint_states(self, now_ns: int) -> bytes:
+        """sensor_msgs/JointState of the wheels as CDR."""
+        robot = self.sim_robot.robot
+        count = len(self.joint_names)
+        return encode.joint_state(
+            now_ns, self.joint_names, robot.wheels[:count], robot.wheel_rates[:count]
+        )
+
+    def laser_scan(self, lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:
+        """sensor_msgs/LaserScan of one of the robot's LiDARs as CDR."""
+        frame, fields = self.scans[lidar]
+        return encode.laser_scan(now_ns, frame, fields, ranges)
+
+
 def odometry_bytes(sim_robot: SimRobot, now_ns: int) -> bytes:
     """nav_msgs/Odometry as CDR (same as :func:`odometry`)."""
-    model = sim_robot.robot.spec.model
-    (x, y, yaw), (forward, turn) = sim_robot.robot.odometry()
-    return encode.odometry(
-        now_ns, model.odom_frame.encode(), model.base_frame.encode(),
-        (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), _COVARIANCE,
-        (forward, 0.0, 0.0, 0.0, 0.0, turn),
-    )  # fmt: skip
-
-
-Transform = tuple[bytes, bytes, tuple[float, ...]]
+    return RobotEncoder(sim_robot).odometry(now_ns, sim_robot.robot.odometry())
 
 
 def odom_transform(sim_robot: SimRobot) -> Transform:
     """``odom -> base_footprint`` for :func:`tf_bytes` (same as :func:`odom_tf`)."""
-    model = sim_robot.robot.spec.model
-    (x, y, yaw), _ = sim_robot.robot.odometry()
-    return (model.odom_frame.encode(), model.base_frame.encode(),
-            (x, y, 0.0, *quaternion(0.0, 0.0, yaw)))  # fmt: skip
+    return RobotEncoder(sim_robot).odom_transform(sim_robot.robot.odometry())
 
 
 def wheel_transforms(sim_robot: SimRobot) -> list[Transform]:
     """The wheel links turned by their joints for :func:`tf_bytes` (same as :func:`wheel_tf`)."""
-    model = sim_robot.robot.spec.model
-    angles = dict(zip(model.joints, sim_robot.robot.wheels, strict=False))
-    transforms: list[Transform] = []
-    for frame in model.frames:
-        if frame.joint is None:
-            continue
-        rotation = quaternion(*frame.rpy)
-        spin = angles.get(frame.joint, 0.0)
-        if spin:
-            rotation = multiply(rotation, (0.0, 0.0, math.sin(spin / 2), math.cos(spin / 2)))
-        transforms.append((frame.parent.encode(), frame.name.encode(), (*frame.xyz, *rotation)))
-    return transforms
+    return RobotEncoder(sim_robot).wheel_transforms()
 
 
 def tf_bytes(transforms: list[Transform], now_ns: int) -> bytes:
@@ -338,12 +386,7 @@ def tf_bytes(transforms: list[Transform], now_ns: int) -> bytes:
 
 def joint_states_bytes(sim_robot: SimRobot, now_ns: int) -> bytes:
     """sensor_msgs/JointState as CDR (same as :func:`joint_states`)."""
-    robot = sim_robot.robot
-    joints = robot.spec.model.joints
-    return encode.joint_state(
-        now_ns, [j.encode() for j in joints], robot.wheels[: len(joints)],
-        robot.wheel_rates[: len(joints)],
-    )  # fmt: skip
+    return RobotEncoder(sim_robot).joint_states(now_ns)
 
 
 def laser_scan_bytes(lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:

@@ -8,12 +8,17 @@ is the wheels' grip: the solver cannot slide the robot sideways, so pushing on a
 obstacle stalls it where it hit, as on Gazebo or a real floor (driving free, the velocity
 function alone keeps it on its heading, and the joint costs nothing). Odometry is the body's
 motion relative to its spawn pose, in the ``odom`` frame.
+
+The per-step reads and writes of the body go straight to chipmunk's C functions (pymunk's
+``lib``, the same calls its properties make): the properties' Python layers cost more than
+the physics step itself.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pymunk
 
@@ -25,6 +30,7 @@ if TYPE_CHECKING:
 
 ABSURD = 1e3  # m/s or rad/s: a command beyond this is a bug upstream, not a wish
 GROOVE = 1e3  # metres: half the length of the line the robot may move along in one step
+_LIB: Any = importlib.import_module("pymunk._chipmunk").lib  # what pymunk.Body's properties call
 
 
 class DiffDriveRobot:
@@ -57,6 +63,10 @@ class DiffDriveRobot:
         self.wheel_rates = [0.0, 0.0]  # left, right joint speeds (rad/s)
         self.collisions = 0
         self._alpha = 2.0 * model.max_linear_accel / model.wheel_separation
+        self._accel = model.max_linear_accel
+        self._half = model.wheel_separation / 2
+        self._radius = model.wheel_radius
+        self._c_body = self.body._body  # chipmunk's cpBody*
 
     def command(self, linear: float, angular: float) -> str | None:
         """Set the velocity command; return a warning text when it had to be clamped or dropped."""
@@ -82,14 +92,16 @@ class DiffDriveRobot:
     def _velocity(
         self, body: pymunk.Body, gravity: tuple[float, float], damping: float, dt: float
     ) -> None:
-        model = self.spec.model
-        dv = model.max_linear_accel * dt
+        dv = self._accel * dt
         dw = self._alpha * dt
-        self.v += max(-dv, min(dv, self.target[0] - self.v))
-        self.w += max(-dw, min(dw, self.target[1] - self.w))
-        angle = body.angle
-        body.velocity = (self.v * math.cos(angle), self.v * math.sin(angle))
-        body.angular_velocity = self.w
+        target_v, target_w = self.target
+        v = self.v + max(-dv, min(dv, target_v - self.v))
+        w = self.w + max(-dw, min(dw, target_w - self.w))
+        self.v, self.w = v, w
+        c_body = self._c_body
+        angle = _LIB.cpBodyGetAngle(c_body)
+        _LIB.cpBodySetVelocity(c_body, (v * math.cos(angle), v * math.sin(angle)))
+        _LIB.cpBodySetAngularVelocity(c_body, w)
 
     def before_step(self, dt: float) -> None:
         """Put the wheels' grip along the heading, through where the robot is about to be.
@@ -97,7 +109,7 @@ class DiffDriveRobot:
         pymunk moves the body first and solves the constraints after, so the groove goes
         where this step's motion takes the body, along the heading it will have there.
         """
-        if not self.contacts:
+        if not self.contacts:  # driving free: nothing to do (the common case)
             if self._gripping:
                 self._space.remove(self.grip)
                 self._gripping = False
@@ -115,23 +127,25 @@ class DiffDriveRobot:
 
     def after_step(self, dt: float) -> None:
         """Advance the wheel joints with the motion the solver allowed."""
-        model = self.spec.model
-        angle = self.body.angle
-        vx, vy = self.body.velocity
-        forward = vx * math.cos(angle) + vy * math.sin(angle)
-        w = self.body.angular_velocity
-        half = model.wheel_separation / 2
-        left = (forward - w * half) / model.wheel_radius
-        right = (forward + w * half) / model.wheel_radius
-        self.wheel_rates[0], self.wheel_rates[1] = left, right
-        self.wheels[0] += left * dt
-        self.wheels[1] += right * dt
+        c_body = self._c_body
+        angle = _LIB.cpBodyGetAngle(c_body)
+        velocity = _LIB.cpBodyGetVelocity(c_body)
+        forward = velocity.x * math.cos(angle) + velocity.y * math.sin(angle)
+        w = _LIB.cpBodyGetAngularVelocity(c_body)
+        half, radius = self._half, self._radius
+        left = (forward - w * half) / radius
+        right = (forward + w * half) / radius
+        rates, wheels = self.wheel_rates, self.wheels
+        rates[0], rates[1] = left, right
+        wheels[0] += left * dt
+        wheels[1] += right * dt
 
     @property
     def pose(self) -> tuple[float, float, float]:
         """(x, y, yaw) in the world."""
-        x, y = self.body.position
-        return (x, y, self.body.angle)
+        c_body = self._c_body
+        position = _LIB.cpBodyGetPosition(c_body)
+        return (position.x, position.y, _LIB.cpBodyGetAngle(c_body))
 
     def odometry(self) -> tuple[tuple[float, float, float], tuple[float, float]]:
         """((x, y, yaw) in the odom frame, (forward speed, yaw rate))."""
@@ -139,6 +153,10 @@ class DiffDriveRobot:
         x, y, yaw = self.pose
         c, s = math.cos(-yaw0), math.sin(-yaw0)
         dx, dy = x - x0, y - y0
-        vx, vy = self.body.velocity
-        forward = vx * math.cos(yaw) + vy * math.sin(yaw)
-        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (forward, self.body.angular_velocity)
+        c_body = self._c_body
+        velocity = _LIB.cpBodyGetVelocity(c_body)
+        forward = velocity.x * math.cos(yaw) + velocity.y * math.sin(yaw)
+        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (
+            forward,
+            _LIB.cpBodyGetAngularVelocity(c_body),
+        )

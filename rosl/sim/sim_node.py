@@ -12,10 +12,18 @@ Modes: paced at ``real_time_factor`` x wall time (default 1); ``fast``: lock-ste
 next step, so the run does not depend on the machine's speed. Within a step the sensor
 messages go out before ``/clock``, so a timer woken by the new time sees the step's data.
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
+
+Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
+small messages join their topic's batch, which this thread sends once a millisecond of wall
+time and before it sleeps (sensors first, ``/clock`` last; no timer thread contends for the
+GIL), and the bus is served at that pace rather than every step: a datagram per step per topic
+would cost more than the physics. Lock-step and recording
+keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass
@@ -37,6 +45,7 @@ if TYPE_CHECKING:
     from rosl.sim.simulation import SimRobot, Simulation
 
 NS = 1_000_000_000
+SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
 
 
 class _Topic:
@@ -46,14 +55,20 @@ class _Topic:
         self.sim_node = sim_node
         self.publisher = publisher
         self.always = always
+        self._publish = publisher.publish
 
     def wanted(self) -> bool:
         return self.always or self.sim_node.subscribed(self.publisher.topic)
 
     def send(self, message: Any) -> None:
-        self.publisher.publish(message)
-        if self.sim_node.lockstep is not None:
-            self.sim_node.lockstep.published(self.publisher)
+        self._publish(message)
+        lockstep = self.sim_node.lockstep
+        if lockstep is not None:
+            lockstep.published(self.publisher)
+
+    def free(self) -> None:
+        """No lock-step: sending is publishing, one call less per message."""
+        self.send = self._publish  # type: ignore[method-assign,assignment]
 
 
 @dataclass(slots=True)
@@ -63,6 +78,7 @@ class _RobotTopics:
     joints: _Topic | None
     scans: list[_Topic]
     description: Publisher
+    encoder: build.RobotEncoder
 
 
 class SimNode:
@@ -97,15 +113,18 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
+        self._next_event = 0.0  # sim ns of the next sensor or odometry firing
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self._batched = not options.fast and options.record is None
         self.clock = _Topic(
             self,
             node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
             always=True,
         )
         self.tf = _Topic(
-            self, node.create_publisher(build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100)
+            self,
+            node.create_publisher(build.msg("tf2_msgs/msg/TFMessage"), "/tf", 100),
         )
         self.tf_static = node.create_publisher(
             build.msg("tf2_msgs/msg/TFMessage"), "/tf_static", latched
@@ -124,7 +143,9 @@ class SimNode:
             odom = _Topic(
                 self,
                 node.create_publisher(
-                    build.msg("nav_msgs/msg/Odometry"), f"{prefix}/{model.odom_topic}", 10
+                    build.msg("nav_msgs/msg/Odometry"),
+                    f"{prefix}/{model.odom_topic}",
+                    10,
                 ),
             )
             joints = None
@@ -151,7 +172,11 @@ class SimNode:
             description = node.create_publisher(
                 build.msg("std_msgs/msg/String"), f"{prefix}/robot_description", latched
             )
-            self.robots.append(_RobotTopics(sim_robot, odom, joints, scans, description))
+            self.robots.append(
+                _RobotTopics(
+                    sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
+                )
+            )
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -200,33 +225,47 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
+        if now < self._next_event:  # most steps: only the time moves on
+            self._send_clock(build.clock_bytes(now))
+            return
         sampled = False
         transforms: list[build.Transform] = []
         for topics in self.robots:
             sim_robot = topics.sim_robot
+            encoder = topics.encoder
             if sim_robot.odom.due(now):
                 sim_robot.odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
+                odom = sim_robot.robot.odometry()
                 if topics.odom.wanted():
-                    topics.odom.send(build.odometry_bytes(sim_robot, now))
-                transforms.append(build.odom_transform(sim_robot))
+                    topics.odom.send(encoder.odometry(now, odom))
+                transforms.append(encoder.odom_transform(odom))
             if sim_robot.joints is not None and sim_robot.joints.due(now):
                 sim_robot.joints.fire(now)
                 if topics.joints is not None and topics.joints.wanted():
-                    topics.joints.send(build.joint_states_bytes(sim_robot, now))
-                transforms += build.wheel_transforms(sim_robot)
+                    topics.joints.send(encoder.joint_states(now))
+                transforms += encoder.wheel_transforms()
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
                 if schedule.due(now):
                     index = schedule.fire(now)
                     if topic.wanted() or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if topic.wanted():
-                            topic.send(build.laser_scan_bytes(lidar, ranges, now))
+                            topic.send(encoder.laser_scan(lidar, ranges, now))
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))
         self.clock.send(build.clock_bytes(now))
+        self._next_event = min(
+            [r.odom.at_ns for r in sim.robots]
+            + [r.joints.at_ns for r in sim.robots if r.joints is not None]
+            + [schedule.at_ns for r in sim.robots for _, schedule in r.lidars],
+            default=math.inf,
+        )
+
+    def _send_clock(self, data: bytes) -> None:
+        self.clock.send(data)
 
     # --- running -----------------------------------------------------------------------------
 
@@ -245,10 +284,15 @@ class SimNode:
                 on_stall=options.on_stall,
                 log=lambda line: self._logger().warn(line),
             )
-            for publisher in [self.clock, self.tf] + [
-                t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t
-            ]:
-                self.lockstep.mark(publisher.publisher)
+            for topic in self._stepped():
+                self.lockstep.mark(topic.publisher)
+        else:
+            for topic in self._stepped():
+                topic.free()
+            self._send_clock = self.clock.send  # type: ignore[method-assign,assignment]
+        if self._batched:
+            for topic in self._stepped():
+                topic.publisher.hold_until_flush()
         self.publish_static()
         self._announce()
         self._wait_for_peers()
@@ -261,21 +305,63 @@ class SimNode:
         status_at = started + 1.0
         live = not options.headless and sys.stderr.isatty()
         self.tick()
-        while context.ok():
-            self._settle()
-            if end_ns is not None and self.sim.now_ns >= end_ns:
-                break
-            if not options.fast:
-                self._pace(started)
-            self.sim.step()
-            self.tick()
-            if live and time.monotonic() >= status_at:
-                status_at += 1.0
-                self._status(started)
+        if self._batched:
+            self._run_paced(started, end_ns, live)
+        else:
+            sim, tick, settle = self.sim, self.tick, self._settle
+            while context.ok():
+                settle()
+                if end_ns is not None and sim.now_ns >= end_ns:
+                    break
+                if not options.fast:
+                    self._pace(started)
+                sim.step()
+                tick()
+                if live and time.monotonic() >= status_at:
+                    status_at += 1.0
+                    self._status(started)
+        self._flush()  # what the batches still hold
         wall = time.monotonic() - started
         if live:
             sys.stderr.write("\n")
         return self._finish(wall)
+
+    def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
+        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
+        sim, tick, step = self.sim, self.tick, self.sim.step
+        context, monotonic = self.node.context, time.monotonic
+        scale = NS * self.options.real_time_factor  # sim ns per wall second
+        status_at = started + 1.0
+        serve_at = 0.0
+        while True:
+            wall = monotonic()
+            if wall >= serve_at:
+                self._flush()
+                if not context.ok():
+                    return
+                self.executor.spin_some()  # /cmd_vel, parameters
+                serve_at = wall + SERVE_EVERY_S
+                if live and wall >= status_at:
+                    status_at += 1.0
+                    self._status(started)
+            if end_ns is not None and sim.now_ns >= end_ns:
+                return
+            if started + (sim.now_ns + sim.step_ns) / scale > wall:
+                self._pace(started)
+            step()
+            tick()
+
+    def _flush(self) -> None:
+        """Paced: send what the batches hold, the sensors' first and ``/clock`` last."""
+        if self._batched:
+            for topic in reversed(self._stepped()):
+                topic.publisher.flush()
+
+    def _stepped(self) -> list[_Topic]:
+        """The topics published as the simulation steps."""
+        return [self.clock, self.tf] + [
+            t for r in self.robots for t in (r.odom, r.joints, *r.scans) if t
+        ]
 
     def _settle(self) -> None:
         """After a step's messages went out: wait (lock-step) and record."""
@@ -311,10 +397,14 @@ class SimNode:
         """Real-time factor pacing: serve the bus until the next step is due in wall time."""
         factor = self.options.real_time_factor
         due = started + (self.sim.now_ns + self.sim.step_ns) / NS / factor
+        flushed = False
         while self.node.context.ok():
             remaining = due - time.monotonic()
             if remaining <= 0:
                 return
+            if not flushed:  # about to wait: what the batches hold goes out now
+                self._flush()
+                flushed = True
             self.executor.spin_once(remaining)
 
     def _wait_for_peers(self) -> None:

@@ -36,15 +36,23 @@ class Schedule:
 
     rate: float
     index: int = 0  # the next firing's k
+    at_ns: float = field(init=False)  # when it is due (inf: never), kept by fire()
+
+    def __post_init__(self) -> None:
+        self.at_ns = self._at(self.index)
+
+    def _at(self, index: int) -> float:
+        return round(index * NS / self.rate) if self.rate > 0 else math.inf
 
     def due(self, now_ns: int) -> bool:
         """Whether the next firing is due at ``now_ns``."""
-        return self.rate > 0 and now_ns >= round(self.index * NS / self.rate)
+        return now_ns >= self.at_ns
 
     def fire(self, now_ns: int) -> int:
         """Take the due firing; return its k. Firings missed in one step are skipped."""
         index = self.index
         self.index = max(index + 1, math.floor(now_ns * self.rate / NS) + 1)
+        self.at_ns = self._at(self.index)
         return index
 
 
@@ -77,6 +85,8 @@ class Simulation:
         self.seed = world.seed if seed is None else seed
         self.space = WorldSpace(world)
         self.step_ns = world.step_ns
+        self._dt = self.step_ns / NS
+        self._space_step = self.space.space.step
         self.now_ns = 0
         self.steps = 0
         self.robots: list[SimRobot] = []
@@ -105,15 +115,17 @@ class Simulation:
 
     def step(self) -> None:
         """Advance the physics by one fixed step."""
-        dt = self.step_ns / NS
-        for sim_robot in self.robots:
+        dt = self._dt
+        robots = self.robots
+        for sim_robot in robots:
             sim_robot.robot.before_step(dt)
-        self.space.space.step(dt)
+        self._space_step(dt)
         self.now_ns += self.step_ns
         self.steps += 1
-        for sim_robot in self.robots:
-            sim_robot.robot.after_step(dt)
-            x, y, _ = sim_robot.robot.pose
+        for sim_robot in robots:
+            robot = sim_robot.robot
+            robot.after_step(dt)
+            x, y, _ = robot.pose
             lx, ly = sim_robot.last_xy
             sim_robot.distance += math.hypot(x - lx, y - ly)
             sim_robot.last_xy = (x, y)

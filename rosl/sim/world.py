@@ -103,6 +103,13 @@ class Geometry:
         self.segments = np.array(segments, dtype=np.float64).reshape(-1, 4)
         self.closed = np.array(closed, dtype=bool)
         self.circles = np.array(circles, dtype=np.float64).reshape(-1, 3)
+        seg = self.segments  # what near() needs of each edge, computed once
+        self._x1, self._y1 = seg[:, 0].copy(), seg[:, 1].copy()
+        self._ex, self._ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
+        self._length2 = np.maximum(self._ex * self._ex + self._ey * self._ey, 1e-18)
+        self._open = ~self.closed
+        self._cx, self._cy = self.circles[:, 0].copy(), self.circles[:, 1].copy()
+        self._radius = self.circles[:, 2].copy()
 
     def near(
         self, x: float, y: float, reach: float, *, facing: bool = False
@@ -113,19 +120,17 @@ class Geometry:
         """
         seg = self.segments
         if len(seg):
-            ex, ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
-            length2 = np.maximum(ex * ex + ey * ey, 1e-18)
-            t = np.clip(((x - seg[:, 0]) * ex + (y - seg[:, 1]) * ey) / length2, 0.0, 1.0)
-            dx, dy = seg[:, 0] + t * ex - x, seg[:, 1] + t * ey - y
+            ex, ey, x1, y1 = self._ex, self._ey, self._x1, self._y1
+            rx, ry = x - x1, y - y1
+            t = np.minimum(np.maximum((rx * ex + ry * ey) / self._length2, 0.0), 1.0)
+            dx, dy = x1 + t * ex - x, y1 + t * ey - y
             keep = dx * dx + dy * dy <= reach * reach
             if facing:  # outward normal of a ccw edge is (ey, -ex); the sensor must be outside
-                outside = (x - seg[:, 0]) * ey - (y - seg[:, 1]) * ex > 0.0
-                keep &= outside | ~self.closed
+                keep &= (rx * ey - ry * ex > 0.0) | self._open
             seg = seg[keep]
         cir = self.circles
         if len(cir):
-            d = np.hypot(cir[:, 0] - x, cir[:, 1] - y) - cir[:, 2]
-            cir = cir[d <= reach]
+            cir = cir[np.hypot(self._cx - x, self._cy - y) - self._radius <= reach]
         return seg, cir
 
 

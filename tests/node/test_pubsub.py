@@ -380,3 +380,28 @@ def test_a_coalescing_publisher_delivers_every_message_in_order(ros, spawn):
     assert spin_until(node, lambda: len(heard) >= 500, 10.0), len(heard)
     assert heard == [str(n) for n in range(500)]
     assert node.subscriptions[0].lost == 0
+
+
+def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(ros, spawn):
+    from std_msgs.msg import String
+
+    child = spawn(ECHO)  # prints what it hears on "ping"
+    child.expect("^ready$")
+    node = ros.Node("holder")
+    pub = node.create_publisher(String, "ping", 10)
+    assert spin_until(node, lambda: pub.get_subscription_count() > 0, 20.0)
+    pub.publish(String(data="probe"))  # a sent message: the child hears this one
+    child.expect("^heard: probe$")
+    pub.hold_until_flush()
+    for k in range(5):
+        pub.publish(String(data=f"held {k}"))
+    spin_for(node, 1.0)
+    pub.publish(String(data="after"))  # in the same batch: still nothing sent
+    spin_for(node, 1.0)
+    assert child.count("^heard: (held|after)") == 0
+
+    pub.flush()
+
+    for k in range(5):
+        child.expect(f"^heard: held {k}$")
+    child.expect("^heard: after$")

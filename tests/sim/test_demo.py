@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import pytest
 
 from tests.conftest import REPO
-from tests.sim.conftest import read_bag
+from tests.sim.conftest import raw_bag, read_bag
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -70,3 +70,24 @@ def test_what_the_demo_leaves_in_the_folder_is_ignored_by_git(demo_run: tuple[Pa
     )
 
     assert sorted(checked.stdout.splitlines()) == sorted(as_if_in_the_repo), checked
+
+
+def test_two_lock_step_runs_of_the_demo_record_byte_identical_bags(
+    processes: Processes, tmp_path: Path
+) -> None:
+    recorded = []
+    for run in ("first", "second"):
+        folder = tmp_path / run
+        folder.mkdir()
+        child = processes.rosl(
+            "launch", "rosl_sim", "demo.launch.py", "duration:=4", "bag:=demo", cwd=folder,
+            env={"NO_COLOR": "1"},
+        )  # fmt: skip
+        out, err = child.communicate(timeout=180)
+        assert child.returncode == 0, out[-3000:] + err[-3000:]
+        (mcap,) = (folder / "demo").glob("*.mcap")
+        recorded.append(mcap.read_bytes())
+        topics = {topic for topic, _, _ in raw_bag(folder / "demo")}
+        assert {"/scan", "/odom", "/tf", "/clock", "/cmd_vel"} <= topics, topics
+
+    assert recorded[0] == recorded[1]
