@@ -1,0 +1,102 @@
+"""Zenoh configuration as rmw_zenoh users set it: a router on localhost:7447, peers, env overrides.
+
+* a session (every rosl process on the Zenoh transport) is a peer that connects to the router
+  at ``tcp/localhost:7447`` and listens on a free port of localhost, with multicast scouting
+  off, as rmw_zenoh's default session configuration; ``ZENOH_SESSION_CONFIG_URI`` names a
+  Zenoh configuration file to start from instead;
+* ``rosl zenoh router`` opens a session in router mode listening on ``tcp/127.0.0.1:7447``;
+  ``ZENOH_ROUTER_CONFIG_URI`` names a file to start from instead;
+* ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``, each value JSON5) applies last to
+  both, e.g. ``connect/endpoints=["tcp/192.168.1.2:7447"]``.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+from rosl.bus.errors import BusError
+
+if TYPE_CHECKING:
+    import zenoh
+
+ROUTER_ENDPOINT = "tcp/localhost:7447"
+ROUTER_LISTEN = "tcp/127.0.0.1:7447"
+
+
+def _zenoh() -> object:
+    try:
+        import zenoh
+    except ImportError as err:  # pragma: no cover - a dependency of rosl
+        raise BusError(f"the Zenoh transport needs eclipse-zenoh: {err}") from None
+    return zenoh
+
+
+def _base(uri_variable: str, defaults: dict[str, str]) -> zenoh.Config:
+    import zenoh
+
+    _zenoh()
+    path = os.environ.get(uri_variable, "").strip()
+    if path:
+        try:
+            return zenoh.Config.from_file(path)
+        except (zenoh.ZError, OSError, ValueError) as err:
+            raise BusError(f"{uri_variable}={path}: not a Zenoh configuration: {err}") from None
+    config = zenoh.Config()
+    for key, value in defaults.items():
+        config.insert_json5(key, value)
+    return config
+
+
+def apply_overrides(config: zenoh.Config, overrides: str | None = None) -> zenoh.Config:
+    """Apply ``ZENOH_CONFIG_OVERRIDE`` (or ``overrides``) to a configuration.
+
+    Raises:
+        BusError: an override that is not ``key=value`` or that Zenoh refuses.
+    """
+    import zenoh
+
+    text = os.environ.get("ZENOH_CONFIG_OVERRIDE", "") if overrides is None else overrides
+    for item in filter(None, (part.strip() for part in text.split(";"))):
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise BusError(f"ZENOH_CONFIG_OVERRIDE: {item!r} is not key=value")
+        try:
+            config.insert_json5(key.strip(), value.strip())
+        except (zenoh.ZError, ValueError) as err:
+            raise BusError(f"ZENOH_CONFIG_OVERRIDE: {item!r}: {err}") from None
+    return config
+
+
+def session_config() -> zenoh.Config:
+    """A peer's configuration: rmw_zenoh's defaults, the file, then the overrides."""
+    defaults = {
+        "mode": '"peer"',
+        "connect/endpoints": f'["{ROUTER_ENDPOINT}"]',
+        "listen/endpoints": '["tcp/localhost:0"]',
+        "scouting/multicast/enabled": "false",
+    }
+    return apply_overrides(_base("ZENOH_SESSION_CONFIG_URI", defaults))
+
+
+def router_config(listen: str | None = None) -> zenoh.Config:
+    """A router's configuration: listening on ``listen`` (localhost:7447), no scouting."""
+    defaults = {
+        "mode": '"router"',
+        "listen/endpoints": f'["{listen or ROUTER_LISTEN}"]',
+        "scouting/multicast/enabled": "false",
+    }
+    config = _base("ZENOH_ROUTER_CONFIG_URI", defaults)
+    if listen:
+        config.insert_json5("listen/endpoints", f'["{listen}"]')
+    return apply_overrides(config)
+
+
+def open_session(config: zenoh.Config) -> zenoh.Session:
+    """Open a Zenoh session; BusError when Zenoh cannot."""
+    import zenoh
+
+    try:
+        return zenoh.open(config)
+    except zenoh.ZError as err:
+        raise BusError(f"cannot open a Zenoh session: {err}") from None
