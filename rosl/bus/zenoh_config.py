@@ -86,10 +86,10 @@ def router_config(listen: str | None = None) -> zenoh.Config:
         "listen/endpoints": f'["{listen or ROUTER_LISTEN}"]',
         "scouting/multicast/enabled": "false",
     }
-    config = _base("ZENOH_ROUTER_CONFIG_URI", defaults)
-    if listen:
+    config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
+    if listen:  # the command line wins over the file and the overrides
         config.insert_json5("listen/endpoints", f'["{listen}"]')
-    return apply_overrides(config)
+    return config
 
 
 def open_session(config: zenoh.Config) -> zenoh.Session:
@@ -100,3 +100,19 @@ def open_session(config: zenoh.Config) -> zenoh.Session:
         return zenoh.open(config)
     except zenoh.ZError as err:
         raise BusError(f"cannot open a Zenoh session: {err}") from None
+
+
+def serve_forever(session: zenoh.Session) -> None:
+    """Keep a (router) session open until interrupted, then close it."""
+    import threading
+
+    try:
+        threading.Event().wait()
+    finally:
+        session.close()
+
+
+def router_listen_text() -> str:
+    """Where a router without ``--listen`` listens, for messages."""
+    path = os.environ.get("ZENOH_ROUTER_CONFIG_URI", "").strip()
+    return f"the endpoints of {path}" if path else ROUTER_LISTEN
