@@ -109,7 +109,7 @@ def serve_forever(session: zenoh.Session) -> None:
     try:
         threading.Event().wait()
     finally:
-        session.close()
+        session.close()  # type: ignore[no-untyped-call]
 
 
 def router_listen_text() -> str:

@@ -20,6 +20,7 @@ and orders); the receivers' readers keep filtering by topic and counting per pub
 from __future__ import annotations
 
 import collections
+import contextlib
 import json
 import threading
 import time
@@ -41,13 +42,12 @@ if TYPE_CHECKING:
 
     import zenoh
 
+    from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
 
 MAX_DATAGRAM = 1 << 30  # Zenoh fragments and reassembles: rosl never splits a message
 ROSL_PREFIX = "@rosl"
 QUEUE_LIMIT = 65536  # deliveries a receiver holds before new ones are dropped
-_KIND_OF_ENDPOINT = {"publisher": wire.PUBLISHER, "subscription": wire.SUBSCRIPTION,
-                     "server": wire.SERVER, "client": wire.CLIENT}  # fmt: skip
 
 
 @dataclass(slots=True)
@@ -90,7 +90,9 @@ class ZenohTransport:
         self.domain = domain
         self.max_datagram = MAX_DATAGRAM
         self.pacer = pacer_from_env(True)
-        self.auth = None  # Zenoh authenticates links itself (TLS, user/password in its config)
+        self.auth: Auth | None = (
+            None  # Zenoh authenticates links itself (TLS, user/password in its config)
+        )
         self._closed = False
         self.session: zenoh.Session = open_session(session_config())
         self.zid = str(self.session.info.zid())
@@ -218,8 +220,18 @@ class ZenohTransport:
                 kind, body = Kind.FAILURE, _failure(reply.err)
             now = time.time_ns()
             self._deliver(
-                Delivery(kind, sender, endpoint, seq, topic, type_, now, now,
-                         memoryview(body), (sender, endpoint, seq))  # fmt: skip
+                Delivery(
+                    kind,
+                    sender,
+                    endpoint,
+                    seq,
+                    topic,
+                    type_,
+                    now,
+                    now,
+                    memoryview(body),
+                    (sender, endpoint, seq),
+                )
             )
 
         self.session.get(
@@ -285,8 +297,17 @@ class ZenohTransport:
         endpoint = int.from_bytes(gid[8:10], "little")
         payload = sample.payload.to_bytes()
         self._deliver(
-            Delivery(Kind.DATA, sender, endpoint, seq & 0xFFFFFFFF, hash_topic(key.name),
-                     hash_type(key.type), stamp, time.time_ns(), memoryview(payload))  # fmt: skip
+            Delivery(
+                Kind.DATA,
+                sender,
+                endpoint,
+                seq & 0xFFFFFFFF,
+                hash_topic(key.name),
+                hash_type(key.type),
+                stamp,
+                time.time_ns(),
+                memoryview(payload),
+            )
         )
 
     def _on_query(self, query: zenoh.Query) -> None:
@@ -306,8 +327,17 @@ class ZenohTransport:
             self._queries[(sender, endpoint, seq)] = (query, gid)
         body = query.payload.to_bytes() if query.payload is not None else b""
         self._deliver(
-            Delivery(Kind.REQUEST, sender, endpoint, seq, hash_topic(key.name),
-                     hash_type(key.type), stamp, time.time_ns(), memoryview(body))  # fmt: skip
+            Delivery(
+                Kind.REQUEST,
+                sender,
+                endpoint,
+                seq,
+                hash_topic(key.name),
+                hash_type(key.type),
+                stamp,
+                time.time_ns(),
+                memoryview(body),
+            )
         )
 
     def _deliver(self, delivery: Delivery) -> None:
@@ -345,10 +375,8 @@ class ZenohTransport:
             receiver.close()
         self.foreign.close()
         self.local.update(None)
-        try:
-            self.session.close()
-        except Exception:  # noqa: S110 - closing at exit: nothing left to tell
-            pass
+        with contextlib.suppress(Exception):  # closing at exit: nothing left to tell
+            self.session.close()  # type: ignore[no-untyped-call]
 
 
 def _failure(err: Any) -> bytes:
@@ -356,7 +384,7 @@ def _failure(err: Any) -> bytes:
     if err is not None:
         try:
             text = err.payload.to_string()
-        except Exception:  # noqa: BLE001 - a payload that is not text
+        except Exception:
             text = "the server failed (a reply error that is not text)"
     if text.startswith("{"):
         return text.encode()  # rosl's own failure payload (JSON)

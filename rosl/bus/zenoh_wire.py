@@ -70,7 +70,7 @@ class Qos:
         )  # fmt: skip
 
     def words(self) -> dict[str, object]:
-        """rosl's QoS words for this profile (for the graph)."""
+        """Rosl's QoS words for this profile (for the graph)."""
         return {
             "reliability": _name(RELIABILITY, self.reliability),
             "durability": _name(DURABILITY, self.durability),

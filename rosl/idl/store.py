@@ -158,7 +158,7 @@ class Store:
                                  ("event", "Event"))
         ]  # fmt: skip
         with self._lock:
-            self._typestore.fielddefs[service_type] = ([], fields)
+            self._typestore.fielddefs[service_type] = ([], fields)  # type: ignore[assignment]
             try:
                 return self.type_hash(service_type)
             finally:

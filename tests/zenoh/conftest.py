@@ -12,8 +12,6 @@ import pytest
 from tests.conftest import ChildOutput, wait_until
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
-
     from tests.conftest import Processes
 
 PEER = str(Path(__file__).with_name("peer.py"))
@@ -57,7 +55,7 @@ class Router:
 
 
 @pytest.fixture
-def router(processes: Processes, domain_id: int, monkeypatch: pytest.MonkeyPatch) -> Iterator[Router]:
+def router(processes: Processes, domain_id: int, monkeypatch: pytest.MonkeyPatch) -> Router:
     """A router; rosl (this process and its children) on Zenoh, connected to it."""
     port = free_port()
     monkeypatch.setenv("ROSL_TRANSPORT", "zenoh")
@@ -67,7 +65,7 @@ def router(processes: Processes, domain_id: int, monkeypatch: pytest.MonkeyPatch
     )
     monkeypatch.delenv("ZENOH_SESSION_CONFIG_URI", raising=False)
     monkeypatch.delenv("ZENOH_ROUTER_CONFIG_URI", raising=False)
-    yield Router(processes, port)
+    return Router(processes, port)
 
 
 __all__ = ["Router", "free_port", "wait_output", "wait_until"]

@@ -54,8 +54,12 @@ def main() -> None:
     config.insert_json5("scouting/multicast/enabled", "false")
     session = zenoh.open(config)
     zid = str(session.info.zid())
-    node = {"talker": "talker", "listener": "listener", "server": "add_two_ints_server",
-            "client": "add_two_ints_client"}[role]
+    node = {
+        "talker": "talker",
+        "listener": "listener",
+        "server": "add_two_ints_server",
+        "client": "add_two_ints_client",
+    }[role]
     prefix = f"@ros2_lv/{domain}/{zid}/0"
     tokens = [session.liveliness().declare_token(f"{prefix}/0/NN/%/%/{node}")]
     if role in ("talker", "listener"):
@@ -74,31 +78,38 @@ def main() -> None:
         seq = 0
         while True:
             seq += 1
-            publisher.put(string_cdr(f"Hello World: {seq}"),
-                          attachment=attachment(seq, time.time_ns(), me))
+            publisher.put(
+                string_cdr(f"Hello World: {seq}"), attachment=attachment(seq, time.time_ns(), me)
+            )
             time.sleep(0.1)
     elif role == "listener":
+
         def heard(sample: zenoh.Sample) -> None:
             if sample.attachment is None:
                 return
             raw = sample.attachment.to_bytes()
             seq, _stamp = struct.unpack_from("<qq", raw)
-            print(f"heard {read_string(sample.payload.to_bytes())!r} seq={seq} "
-                  f"gidlen={raw[16]} size={len(raw)}", flush=True)
+            print(
+                f"heard {read_string(sample.payload.to_bytes())!r} seq={seq} "
+                f"gidlen={raw[16]} size={len(raw)}",
+                flush=True,
+            )
 
         subscriber = session.declare_subscriber(key, heard)
         del subscriber
         while True:
             time.sleep(1)
     elif role == "server":
+
         def serve(query: zenoh.Query) -> None:
             raw = query.attachment.to_bytes()
             seq, _stamp = struct.unpack_from("<qq", raw)
             a, b = struct.unpack_from("<qq", query.payload.to_bytes(), 4)
             print(f"served {a}+{b} seq={seq}", flush=True)
             body = CDR_LE + struct.pack("<q", a + b)
-            query.reply(query.key_expr, body,
-                        attachment=attachment(seq, time.time_ns(), raw[17:33]))
+            query.reply(
+                query.key_expr, body, attachment=attachment(seq, time.time_ns(), raw[17:33])
+            )
 
         queryable = session.declare_queryable(key, serve, complete=True)
         del queryable
@@ -108,9 +119,13 @@ def main() -> None:
         a, b = int(sys.argv[4]), int(sys.argv[5])
         for attempt in range(1, 100):
             request = CDR_LE + struct.pack("<qq", a, b)
-            replies = session.get(key, target=zenoh.QueryTarget.ALL_COMPLETE,
-                                  payload=request, timeout=2.0,
-                                  attachment=attachment(attempt, time.time_ns(), me))
+            replies = session.get(
+                key,
+                target=zenoh.QueryTarget.ALL_COMPLETE,
+                payload=request,
+                timeout=2.0,
+                attachment=attachment(attempt, time.time_ns(), me),
+            )
             for reply in replies:
                 if reply.ok is not None:
                     raw = reply.ok.attachment.to_bytes()

@@ -15,8 +15,9 @@ from tests.zenoh.conftest import Router, wait_output
 def test_a_rosl_node_hears_the_peer_talker_and_the_peer_hears_rosl(
     router: Router, processes: Processes, domain_id: int, ros: object
 ) -> None:
-    import rosl
     from std_msgs.msg import String
+
+    import rosl
 
     router.peer(processes, "talker", domain_id)
     listener = router.peer(processes, "listener", domain_id)
@@ -80,8 +81,9 @@ def test_rosl_service_call_is_answered_by_the_peer_server(
 def test_the_peer_client_is_answered_by_a_rosl_server(
     router: Router, processes: Processes, domain_id: int, ros: object
 ) -> None:
-    import rosl
     from example_interfaces.srv import AddTwoInts
+
+    import rosl
 
     node = rosl.create_node("add_two_ints_server")
 
@@ -107,9 +109,9 @@ def test_the_peer_sees_rosl_liveliness_tokens(
     router: Router, processes: Processes, domain_id: int, ros: object
 ) -> None:
     import zenoh
+    from std_msgs.msg import String
 
     import rosl
-    from std_msgs.msg import String
 
     node = rosl.create_node("talker", namespace="/robot1")
     node.create_publisher(String, "chatter", 7)
