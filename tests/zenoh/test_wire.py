@@ -153,7 +153,7 @@ def test_the_attachment_is_33_bytes_as_the_design_document_lays_it_out() -> None
 
 @pytest.mark.parametrize("data", [b"", bytes(32), bytes(34), bytes(16) + b"\x0f" + bytes(16)])
 def test_malformed_attachments_are_refused(data: bytes) -> None:
-    with pytest.raises(ValueError, match="attachment|GID"):
+    with pytest.raises(ValueError, match=r"attachment|GID"):
         wire.decode_attachment(data)
 
 
@@ -175,7 +175,7 @@ def test_the_gid_is_xxh3_128_of_the_token_low_half_first() -> None:
     ],
 )
 def test_malformed_tokens_are_refused(token: str) -> None:
-    with pytest.raises(ValueError, match="token|QoS|fields|kind|component"):
+    with pytest.raises(ValueError, match=r"token|QoS|fields|kind|component"):
         wire.parse_liveliness(token)
 
 
