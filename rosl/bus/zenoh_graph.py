@@ -191,6 +191,11 @@ class ForeignGraph:
             self._tokens.setdefault(entity.zid, {})[key] = entity
         self._hello(entity.zid, [])
 
+    def zids(self) -> set[str]:
+        """The sessions of the foreign processes known now."""
+        with self._lock:
+            return set(self._tokens)
+
     def answer(self, query: str) -> None:
         """A graph query of this process went out: every foreign process answers it."""
         with self._lock:

@@ -47,6 +47,7 @@ if TYPE_CHECKING:
 
 MAX_DATAGRAM = 1 << 30  # Zenoh fragments and reassembles: rosl never splits a message
 ROSL_PREFIX = "@rosl"
+SETTLE_S = 2.0  # the longest a new session waits for links to the sessions in the graph
 QUEUE_LIMIT = 65536  # deliveries a receiver holds before new ones are dropped
 
 
@@ -109,6 +110,29 @@ class ZenohTransport:
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
         )
         self.foreign = ForeignGraph(self)
+        self._settle()
+
+    def _settle(self, bound_s: float = SETTLE_S) -> None:
+        """Wait (bounded) for direct links to the sessions already in the graph.
+
+        Zenoh peers exchange their subscriptions when they link up; until then, what another
+        rosl process says to this one (the answers to its first graph query) may be dropped.
+        """
+        from rosl.bus.zenoh_graph import ROSL_TOKEN
+
+        known = {self.zid}
+        for reply in self.session.liveliness().get(f"{ROSL_TOKEN}/{self.domain}/*", timeout=1.0):
+            if reply.ok is not None:
+                known.add(str(reply.ok.key_expr).rsplit("/", 1)[1])
+        known |= self.foreign.zids()
+        known.discard(self.zid)
+        deadline = time.monotonic() + bound_s
+        while known and time.monotonic() < deadline:
+            linked = {str(zid) for zid in self.session.info.peers_zid()}
+            if known <= linked:
+                time.sleep(0.05)  # their declarations follow the link at once
+                return
+            time.sleep(0.01)
 
     # --- routes -------------------------------------------------------------------------------
 
