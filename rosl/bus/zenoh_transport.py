@@ -105,6 +105,7 @@ class ZenohTransport:
         self._subscribers: dict[str, Any] = {}  # key -> zenoh.Subscriber
         self._wildcard: Any = None  # the subscriber on every topic (recorders)
         self._queries: dict[tuple[int, int, int], tuple[Any, bytes]] = {}
+        self._key_hashes: dict[str, tuple[int, int]] = {}
         self.local = LocalEntities(self)
         self._rosl_sub = self.session.declare_subscriber(
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
@@ -308,9 +309,19 @@ class ZenohTransport:
         for receiver in receivers:
             receiver.put_datagram(datagram)
 
+    def _hashes(self, keyexpr: str) -> tuple[int, int]:
+        """Rosl's (topic, type) hashes of a data key (cached: computed once per key)."""
+        hashes = self._key_hashes.get(keyexpr)
+        if hashes is None:
+            key = wire.parse_topic_key(keyexpr)
+            hashes = (hash_topic(key.name), hash_type(key.type))
+            if len(self._key_hashes) < 65536:
+                self._key_hashes[keyexpr] = hashes
+        return hashes
+
     def _on_sample(self, sample: zenoh.Sample) -> None:
         try:
-            key = wire.parse_topic_key(str(sample.key_expr))
+            topic, type_ = self._hashes(str(sample.key_expr))
             attachment = sample.attachment
             if attachment is None:
                 return  # rmw_zenoh drops samples without one too
@@ -326,8 +337,8 @@ class ZenohTransport:
                 sender,
                 endpoint,
                 seq & 0xFFFFFFFF,
-                hash_topic(key.name),
-                hash_type(key.type),
+                topic,
+                type_,
                 stamp,
                 time.time_ns(),
                 memoryview(payload),
@@ -336,7 +347,7 @@ class ZenohTransport:
 
     def _on_query(self, query: zenoh.Query) -> None:
         try:
-            key = wire.parse_topic_key(str(query.key_expr))
+            topic, type_ = self._hashes(str(query.key_expr))
             attachment = query.attachment
             if attachment is None:
                 raise ValueError("no attachment")
@@ -356,8 +367,8 @@ class ZenohTransport:
                 sender,
                 endpoint,
                 seq,
-                hash_topic(key.name),
-                hash_type(key.type),
+                topic,
+                type_,
                 stamp,
                 time.time_ns(),
                 memoryview(body),
