@@ -72,7 +72,7 @@ def type_hash_of(type_name: str, service: bool) -> str:
             registry.get_message_class(f"{type_name}_Event")
             return registry.store().service_type_hash(type_name)
         registry.get_message_class(type_name)
-        return registry.store().type_hash(type_name)
+        return registry.store().ros2_type_hash(type_name)
     except (InterfaceError, KeyError, ValueError):
         return ""
 

@@ -138,10 +138,15 @@ class Store:
             ) from err
 
     def type_hash(self, type_name: str) -> str:
-        """Return the RIHS01 hash ROS 2 (Iron and later) gives this type.
+        """Return the RIHS01 hash rosbags gives this type (what bags are checked against)."""
+        return self._typestore.hash_rihs01(type_name)
 
-        ROS 2 hashes a .msg ``char`` as the ``uint8`` it becomes in IDL (rosidl_adapter), so
-        the hash is taken over a view of the definitions that says so.
+    def ros2_type_hash(self, type_name: str) -> str:
+        """Return the RIHS01 hash ROS 2's rosidl gives this type (rmw_zenoh's keys use it).
+
+        It differs from :meth:`type_hash` only for types that hold a .msg ``char``: rosidl
+        hashes it as the ``uint8`` it becomes in IDL, rosbags as FIELD_TYPE_CHAR
+        (std_msgs/msg/Char, service_msgs/msg/ServiceEventInfo and so every service).
         """
         return Typestore.hash_rihs01(cast("Typestore", _Rihs01View(self._typestore)), type_name)
 
@@ -160,7 +165,7 @@ class Store:
         with self._lock:
             self._typestore.fielddefs[service_type] = ([], fields)  # type: ignore[assignment]
             try:
-                return self.type_hash(service_type)
+                return self.ros2_type_hash(service_type)
             finally:
                 del self._typestore.fielddefs[service_type]
 

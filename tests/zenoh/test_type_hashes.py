@@ -32,7 +32,7 @@ NEWER_IN_JAZZY = ["sensor_msgs/msg/Range"]
 
 def _hash(type_name: str) -> str:
     registry.get_message_class(type_name)
-    return registry.store().type_hash(type_name)
+    return registry.store().ros2_type_hash(type_name)
 
 
 def _service_hash(type_name: str) -> str:
