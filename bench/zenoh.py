@@ -275,8 +275,10 @@ def _one(kind: str, port: int, size: int, count: int) -> float:
 
 def _report(port: int, count: int, rounds: int) -> None:
     kinds = ["zenoh", "rosl-zenoh", "rosl-multicast"]
-    print(f"throughput, msgs/s delivered (count {count} per size; publisher flat out;"
-          " 0: nearly all dropped)")
+    print(
+        f"throughput, msgs/s delivered (count {count} per size; publisher flat out;"
+        " 0: nearly all dropped)"
+    )
     print(f"{'size':>8} " + " ".join(f"{k:>15}" for k in kinds) + "  rosl-zenoh/zenoh")
     for size in SIZES:
         n = count if size < 60000 else max(200, count // 10 if size < 1 << 20 else count // 50)
