@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 from typing import TYPE_CHECKING
 
@@ -44,8 +45,24 @@ def _base(uri_variable: str, defaults: dict[str, str]) -> zenoh.Config:
             raise BusError(f"{uri_variable}={path}: not a Zenoh configuration: {err}") from None
     config = zenoh.Config()
     for key, value in defaults.items():
-        config.insert_json5(key, value)
+        _insert(config, key, value, key)
     return config
+
+
+def _insert(config: zenoh.Config, key: str, value: str, what: str) -> None:
+    """Set one configuration value (JSON5); BusError naming ``what`` when Zenoh refuses it."""
+    import zenoh
+
+    try:
+        config.insert_json5(key, value)
+    except (zenoh.ZError, ValueError) as err:
+        raise BusError(f"{what}: Zenoh refuses {value}: {_reason(err)}") from None
+
+
+def _reason(err: Exception) -> str:
+    """The first line of a Zenoh error, without its source location."""
+    text = str(err).split(" at /", 1)[0].replace("\\n", "\n").strip()
+    return text.splitlines()[0].strip() if text else type(err).__name__
 
 
 def apply_overrides(config: zenoh.Config, overrides: str | None = None) -> zenoh.Config:
@@ -54,17 +71,12 @@ def apply_overrides(config: zenoh.Config, overrides: str | None = None) -> zenoh
     Raises:
         BusError: an override that is not ``key=value`` or that Zenoh refuses.
     """
-    import zenoh
-
     text = os.environ.get("ZENOH_CONFIG_OVERRIDE", "") if overrides is None else overrides
     for item in filter(None, (part.strip() for part in text.split(";"))):
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
             raise BusError(f"ZENOH_CONFIG_OVERRIDE: {item!r} is not key=value")
-        try:
-            config.insert_json5(key.strip(), value.strip())
-        except (zenoh.ZError, ValueError) as err:
-            raise BusError(f"ZENOH_CONFIG_OVERRIDE: {item!r}: {err}") from None
+        _insert(config, key.strip(), value.strip(), f"ZENOH_CONFIG_OVERRIDE: {item!r}")
     return config
 
 
@@ -83,12 +95,12 @@ def router_config(listen: str | None = None) -> zenoh.Config:
     """A router's configuration: listening on ``listen`` (localhost:7447), no scouting."""
     defaults = {
         "mode": '"router"',
-        "listen/endpoints": f'["{listen or ROUTER_LISTEN}"]',
+        "listen/endpoints": json.dumps([ROUTER_LISTEN]),
         "scouting/multicast/enabled": "false",
     }
     config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
     if listen:  # the command line wins over the file and the overrides
-        config.insert_json5("listen/endpoints", f'["{listen}"]')
+        _insert(config, "listen/endpoints", json.dumps([listen]), "--listen")
     return config
 
 
@@ -99,7 +111,7 @@ def open_session(config: zenoh.Config) -> zenoh.Session:
     try:
         return zenoh.open(config)
     except zenoh.ZError as err:
-        raise BusError(f"cannot open a Zenoh session: {err}") from None
+        raise BusError(f"cannot open a Zenoh session: {_reason(err)}") from None
 
 
 def serve_forever(session: zenoh.Session) -> None:

@@ -123,3 +123,22 @@ def test_an_unknown_transport_is_refused_by_the_command_line(processes: Processe
     _, err = child.communicate(timeout=60)
     assert child.returncode == 2
     assert "carrier-pigeon" in err
+
+
+def test_a_bad_listen_endpoint_is_one_line(processes: Processes) -> None:
+    child = processes.rosl("zenoh", "router", "--listen", "not an endpoint")
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == 1
+    assert len(err.strip().splitlines()) == 1
+    assert "--listen: Zenoh refuses" in err
+    assert "Traceback" not in err
+
+
+def test_a_second_router_on_a_taken_port_is_one_line(router: Router, processes: Processes) -> None:
+    child = processes.rosl(
+        "zenoh", "router", "--listen", router.endpoint, env={"ZENOH_CONFIG_OVERRIDE": ""}
+    )
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == 1
+    assert len(err.strip().splitlines()) == 1
+    assert "cannot open a Zenoh session" in err
