@@ -155,6 +155,17 @@ class ForeignGraph:
                 known = None
         if known:
             self._bye(zid)  # it was taken for a foreign process before its rosl token came
+        if sample.kind == zenoh.SampleKind.PUT and zid != self._transport.zid:
+            self._ask_for(zid)
+
+    def _ask_for(self, zid: str) -> None:
+        """A rosl process joined: have this process announce itself to it now.
+
+        Its token arrives after its subscriptions did, so this announcement reaches it even
+        where the answers to its own first graph query were sent too early to.
+        """
+        sender = self.sender_of(zid)
+        self._send(sender, {"op": "query", "qid": 0, "sender": f"{sender:016x}"})
 
     def _on_token(self, sample: zenoh.Sample) -> None:
         import zenoh
