@@ -5,7 +5,10 @@ Owns sockets, the datagram header, fragmentation and reassembly, the domain's ad
 message types or the graph; payloads are opaque bytes. Imports only ``rosl.errors``.
 ``transport.py`` is the seam node/ and graph/ use (send, receivers that join channels and
 poll whole deliveries, wake-ups); ``multicast.py`` is the default transport and
-``inprocess.py`` a one-process transport for tests.
+``inprocess.py`` a one-process transport for tests. ``ROSL_TRANSPORT=zenoh`` picks
+``zenoh_transport.py``: the same seam over Zenoh in ROS 2's rmw_zenoh wire format
+(``zenoh_wire.py``: keys, tokens, QoS strings, attachments, GIDs; ``zenoh_graph.py``: liveliness
+tokens and other implementations' nodes; ``zenoh_config.py``: sessions, routers, settings).
 
 How topics map to the network (documented here because users and tools rely on it):
 

@@ -9,8 +9,11 @@ reassembly, early filtering and loss accounting happen inside, in the receiver's
 :func:`channel_of` its hash.
 
 Implementations: :class:`rosl.bus.multicast.MulticastTransport` (UDP multicast, the default)
-and :class:`rosl.bus.inprocess.InProcessTransport` (one process, for tests of the seam). The
-environment variable ``ROSL_TRANSPORT`` picks one (``multicast``, ``inprocess``).
+and :class:`rosl.bus.inprocess.InProcessTransport` (one process, for tests of the seam), and
+:class:`rosl.bus.zenoh_transport.ZenohTransport` (Zenoh in rmw_zenoh's wire format: ROS 2
+nodes, other hosts). The environment variable ``ROSL_TRANSPORT`` picks one (``multicast``,
+``inprocess``, ``zenoh``). A transport may also have ``register_writer(topic, name, type,
+kind)``, called for every new writer: the Zenoh transport learns its key expression there.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ if TYPE_CHECKING:
 
 Buffer = bytes | bytearray | memoryview
 CHANNELS = 64  # data channels per domain (1..CHANNELS); channel 0 is discovery
-TRANSPORTS = ("multicast", "inprocess")
+TRANSPORTS = ("multicast", "inprocess", "zenoh")
 
 
 class Receiver(Protocol):
@@ -106,4 +109,9 @@ def open_transport(domain: int | str | None = None) -> Transport:
         from rosl.bus.multicast import domain_from_env
 
         return InProcessTransport(domain_from_env(domain))
+    if name == "zenoh":
+        from rosl.bus.multicast import domain_from_env
+        from rosl.bus.zenoh_transport import ZenohTransport
+
+        return ZenohTransport(domain_from_env(domain))
     raise BusError(f"ROSL_TRANSPORT={name!r} is not a transport (one of: {', '.join(TRANSPORTS)})")

@@ -216,6 +216,9 @@ class Writer:
         self.batch: Batch | None = None
         self.auth: Auth | None = transport.auth
         self._signed = 0 if self.auth is None else _SIGNED
+        register = getattr(transport, "register_writer", None)
+        if register is not None:  # a transport that routes by name (Zenoh)
+            register(self.topic, name, type_name, int(kind))
 
     def coalesce(self, flusher: Flusher, limit: int) -> None:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""

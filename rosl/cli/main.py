@@ -44,6 +44,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "topic": ("rosl.cli.topic", "Various topic related sub-commands"),
     "viz": ("rosl.cli.viz", "Draw the world, paths, scans and frames from a bag or the bus"),
     "wtf": ("rosl.cli.doctor", "Use `wtf` as alias to `doctor`"),
+    "zenoh": ("rosl.cli.zenoh", "Zenoh: a router for rosl and rmw_zenoh nodes (rmw_zenohd)"),
 }
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 

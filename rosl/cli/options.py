@@ -41,7 +41,15 @@ class GreedyOption(click.Option):
 
 
 def domain_option(command: Any) -> Any:
-    """Add ``--domain-id`` (overrides ROSL_DOMAIN_ID / ROS_DOMAIN_ID) to a command."""
+    """Add ``--domain-id`` (overrides ROSL_DOMAIN_ID / ROS_DOMAIN_ID) and ``--transport``."""
+    command = click.option(
+        "--transport",
+        type=click.Choice(["multicast", "zenoh", "inprocess"]),
+        default=None,
+        expose_value=False,
+        callback=_export_transport,
+        help="Transport to use instead of ROSL_TRANSPORT (zenoh: ROS 2's rmw_zenoh).",
+    )(command)
     return click.option(
         "--domain-id",
         "domain_id",
@@ -49,6 +57,15 @@ def domain_option(command: Any) -> Any:
         default=None,
         help="Domain to use instead of ROSL_DOMAIN_ID / ROS_DOMAIN_ID.",
     )(command)
+
+
+def _export_transport(ctx: click.Context, param: click.Parameter, value: str | None) -> None:
+    """Make ``--transport`` the transport of this process and of every process it starts."""
+    del ctx, param
+    if value is not None:
+        import os
+
+        os.environ["ROSL_TRANSPORT"] = value
 
 
 def export_domain(domain_id: int | None) -> None:

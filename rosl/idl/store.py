@@ -156,8 +156,36 @@ class Store:
             ) from err
 
     def type_hash(self, type_name: str) -> str:
-        """Return the RIHS01 hash ROS 2 (Iron and later) gives this type."""
+        """Return the RIHS01 hash rosbags gives this type (what bags are checked against)."""
         return self._typestore.hash_rihs01(type_name)
+
+    def ros2_type_hash(self, type_name: str) -> str:
+        """Return the RIHS01 hash ROS 2's rosidl gives this type (rmw_zenoh's keys use it).
+
+        It differs from :meth:`type_hash` only for types that hold a .msg ``char``: rosidl
+        hashes it as the ``uint8`` it becomes in IDL, rosbags as FIELD_TYPE_CHAR
+        (std_msgs/msg/Char, service_msgs/msg/ServiceEventInfo and so every service).
+        """
+        return Typestore.hash_rihs01(cast("Typestore", _Rihs01View(self._typestore)), type_name)
+
+    def service_type_hash(self, service_type: str) -> str:
+        """Return the RIHS01 hash ROS 2 gives a service type (``pkg/srv/Name``).
+
+        ROS 2 hashes a service as a message of three fields: ``request_message``,
+        ``response_message`` and ``event_message`` (``<Name>_Request``, ``_Response`` and
+        ``_Event``, which must be registered).
+        """
+        fields = [
+            (f"{part}_message", (Nodetype.NAME, f"{service_type}_{suffix}"))
+            for part, suffix in (("request", "Request"), ("response", "Response"),
+                                 ("event", "Event"))
+        ]  # fmt: skip
+        with self._lock:
+            self._typestore.fielddefs[service_type] = ([], fields)  # type: ignore[assignment]
+            try:
+                return self.ros2_type_hash(service_type)
+            finally:
+                del self._typestore.fielddefs[service_type]
 
     def schema_type_hash(self, type_name: str, encoding: str, text: str) -> str:
         """Return the RIHS01 hash of a type as a recording's schema defines it.
@@ -190,6 +218,31 @@ class Store:
     def fielddefs(self, type_name: str) -> Any:
         """Return rosbags' (constants, fields) entry for a registered type."""
         return self._typestore.fielddefs[type_name]
+
+
+class _Rihs01View:
+    """A type store's definitions as rosidl hashes them: ``char`` read as ``uint8``."""
+
+    def __init__(self, typestore: Typestore) -> None:
+        self.fielddefs = _CharAsUint8(typestore.fielddefs)
+
+
+class _CharAsUint8(dict[str, Any]):
+    def __init__(self, fielddefs: dict[str, Any]) -> None:
+        super().__init__()
+        self._source = fielddefs
+
+    def __getitem__(self, type_name: str) -> Any:
+        constants, fields = self._source[type_name]
+        return constants, [(name, _uint8_char(desc)) for name, desc in fields]
+
+
+def _uint8_char(desc: Any) -> Any:
+    if desc[0] == Nodetype.BASE:
+        return (Nodetype.BASE, ("uint8", 0)) if desc[1][0] == "char" else desc
+    if desc[0] in (Nodetype.ARRAY, Nodetype.SEQUENCE):
+        return (desc[0], (_uint8_char(desc[1][0]), desc[1][1]))
+    return desc
 
 
 _SECTION = "=" * 80 + "\n"

@@ -19,6 +19,24 @@ if TYPE_CHECKING:
 TUTORIAL_PKG = REPO / "examples" / "tutorial_pkg"
 
 
+@pytest.fixture(autouse=True, params=["multicast", "zenoh"])
+def transport(
+    request: pytest.FixtureRequest, processes: Processes, monkeypatch: pytest.MonkeyPatch
+) -> str:
+    """Every end-to-end test runs on both transports (Zenoh: through its own router)."""
+    if request.param == "zenoh":
+        from tests.zenoh.conftest import Router, free_port
+
+        port = free_port()
+        monkeypatch.setenv("ROSL_TRANSPORT", "zenoh")
+        monkeypatch.setenv(
+            "ZENOH_CONFIG_OVERRIDE",
+            f'connect/endpoints=["tcp/127.0.0.1:{port}"];listen/endpoints=["tcp/127.0.0.1:0"]',
+        )
+        Router(processes, port)
+    return str(request.param)
+
+
 @pytest.fixture
 def tutorial(processes: Processes) -> Callable[..., Watched]:
     """Start one tutorial executable (``python -m rosl.pkg.entry``) on the test's domain."""

@@ -1,0 +1,130 @@
+"""Zenoh configuration as rmw_zenoh users set it: a router on localhost:7447, peers, env overrides.
+
+* a session (every rosl process on the Zenoh transport) is a peer that connects to the router
+  at ``tcp/localhost:7447`` and listens on a free port of localhost, with multicast scouting
+  off, as rmw_zenoh's default session configuration; ``ZENOH_SESSION_CONFIG_URI`` names a
+  Zenoh configuration file to start from instead;
+* ``rosl zenoh router`` opens a session in router mode listening on ``tcp/127.0.0.1:7447``;
+  ``ZENOH_ROUTER_CONFIG_URI`` names a file to start from instead;
+* ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``, each value JSON5) applies last to
+  both, e.g. ``connect/endpoints=["tcp/192.168.1.2:7447"]``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import TYPE_CHECKING
+
+from rosl.bus.errors import BusError
+
+if TYPE_CHECKING:
+    import zenoh
+
+ROUTER_ENDPOINT = "tcp/localhost:7447"
+ROUTER_LISTEN = "tcp/127.0.0.1:7447"
+
+
+def _zenoh() -> object:
+    try:
+        import zenoh
+    except ImportError as err:  # pragma: no cover - a dependency of rosl
+        raise BusError(f"the Zenoh transport needs eclipse-zenoh: {err}") from None
+    return zenoh
+
+
+def _base(uri_variable: str, defaults: dict[str, str]) -> zenoh.Config:
+    import zenoh
+
+    _zenoh()
+    path = os.environ.get(uri_variable, "").strip()
+    if path:
+        try:
+            return zenoh.Config.from_file(path)
+        except (zenoh.ZError, OSError, ValueError) as err:
+            raise BusError(f"{uri_variable}={path}: not a Zenoh configuration: {err}") from None
+    config = zenoh.Config()
+    for key, value in defaults.items():
+        _insert(config, key, value, key)
+    return config
+
+
+def _insert(config: zenoh.Config, key: str, value: str, what: str) -> None:
+    """Set one configuration value (JSON5); BusError naming ``what`` when Zenoh refuses it."""
+    import zenoh
+
+    try:
+        config.insert_json5(key, value)
+    except (zenoh.ZError, ValueError) as err:
+        raise BusError(f"{what}: Zenoh refuses {value}: {_reason(err)}") from None
+
+
+def _reason(err: Exception) -> str:
+    """The first line of a Zenoh error, without its source location."""
+    text = str(err).split(" at /", 1)[0].replace("\\n", "\n").strip()
+    return text.splitlines()[0].strip() if text else type(err).__name__
+
+
+def apply_overrides(config: zenoh.Config, overrides: str | None = None) -> zenoh.Config:
+    """Apply ``ZENOH_CONFIG_OVERRIDE`` (or ``overrides``) to a configuration.
+
+    Raises:
+        BusError: an override that is not ``key=value`` or that Zenoh refuses.
+    """
+    text = os.environ.get("ZENOH_CONFIG_OVERRIDE", "") if overrides is None else overrides
+    for item in filter(None, (part.strip() for part in text.split(";"))):
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise BusError(f"ZENOH_CONFIG_OVERRIDE: {item!r} is not key=value")
+        _insert(config, key.strip(), value.strip(), f"ZENOH_CONFIG_OVERRIDE: {item!r}")
+    return config
+
+
+def session_config() -> zenoh.Config:
+    """A peer's configuration: rmw_zenoh's defaults, the file, then the overrides."""
+    defaults = {
+        "mode": '"peer"',
+        "connect/endpoints": f'["{ROUTER_ENDPOINT}"]',
+        "listen/endpoints": '["tcp/localhost:0"]',
+        "scouting/multicast/enabled": "false",
+    }
+    return apply_overrides(_base("ZENOH_SESSION_CONFIG_URI", defaults))
+
+
+def router_config(listen: str | None = None) -> zenoh.Config:
+    """A router's configuration: listening on ``listen`` (localhost:7447), no scouting."""
+    defaults = {
+        "mode": '"router"',
+        "listen/endpoints": json.dumps([ROUTER_LISTEN]),
+        "scouting/multicast/enabled": "false",
+    }
+    config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
+    if listen:  # the command line wins over the file and the overrides
+        _insert(config, "listen/endpoints", json.dumps([listen]), "--listen")
+    return config
+
+
+def open_session(config: zenoh.Config) -> zenoh.Session:
+    """Open a Zenoh session; BusError when Zenoh cannot."""
+    import zenoh
+
+    try:
+        return zenoh.open(config)
+    except zenoh.ZError as err:
+        raise BusError(f"cannot open a Zenoh session: {_reason(err)}") from None
+
+
+def serve_forever(session: zenoh.Session) -> None:
+    """Keep a (router) session open until interrupted, then close it."""
+    import threading
+
+    try:
+        threading.Event().wait()
+    finally:
+        session.close()  # type: ignore[no-untyped-call]
+
+
+def router_listen_text() -> str:
+    """Where a router without ``--listen`` listens, for messages."""
+    path = os.environ.get("ZENOH_ROUTER_CONFIG_URI", "").strip()
+    return f"the endpoints of {path}" if path else ROUTER_LISTEN

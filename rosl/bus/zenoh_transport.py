@@ -1,0 +1,535 @@
+"""The Zenoh transport (``ROSL_TRANSPORT=zenoh``): rosl's seam over Zenoh in rmw_zenoh's format.
+
+Datagrams from the layers above are read here and mapped onto Zenoh as a ROS 2 node using
+``rmw_zenoh_cpp`` would put them (see :mod:`rosl.bus.zenoh_wire`):
+
+* a message (``DATA``) is a ``put`` of its CDR bytes on the topic's key, with the attachment;
+* a request is a ``get`` on the service's key (target ALL_COMPLETE); a server's queryable turns
+  the query into a ``REQUEST`` delivery and its response into the query's ``reply``;
+* this process's nodes and endpoints, read from its own discovery announcements, become
+  liveliness tokens; a subscription becomes a Zenoh subscriber on its topic's key;
+* everything else rosl says (its discovery, transient-local replays, lock-step) travels as
+  rosl datagrams under ``@rosl/<domain>/<channel>``, so rosl processes keep their full graph;
+* nodes of other implementations (liveliness tokens of sessions without a rosl token) are
+  announced to the local graph by :class:`rosl.bus.zenoh_graph.ForeignGraph`.
+
+Received messages become :class:`~rosl.bus.wire.Delivery` records at once (Zenoh reassembles
+and orders); the receivers' readers keep filtering by topic and counting per publisher.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import json
+import threading
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from rosl.bus import zenoh_wire as wire
+from rosl.bus.coalesce import split_records
+from rosl.bus.errors import BusError
+from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
+from rosl.bus.header import topic_hash as hash_topic
+from rosl.bus.header import type_hash as hash_type
+from rosl.bus.pacing import pacer_from_env
+from rosl.bus.transport import channel_of
+from rosl.bus.wire import Delivery, Reader, StreamStats
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import zenoh
+
+    from rosl.bus.auth import Auth
+    from rosl.bus.transport import Buffer
+
+MAX_DATAGRAM = 1 << 30  # Zenoh fragments and reassembles: rosl never splits a message
+ROSL_PREFIX = "@rosl"
+SETTLE_S = 2.0  # the longest a new session waits for links to the sessions in the graph
+QUEUE_LIMIT = 65536  # deliveries a receiver holds before new ones are dropped
+
+
+@dataclass(slots=True)
+class _Route:
+    """What rosl's hashes stand for on Zenoh: one topic or service of this process."""
+
+    name: str
+    type: str
+    key: str  # the data or service key expression ("" when the type has no hash here)
+    service: bool
+
+
+def type_hash_of(type_name: str, service: bool) -> str:
+    """The RIHS01 hash of a type this process can load ("" when it cannot)."""
+    from rosl.idl import registry
+    from rosl.idl.errors import InterfaceError
+
+    try:
+        if service:
+            registry.get_service_class(type_name)
+            registry.get_message_class(f"{type_name}_Event")
+            return registry.store().service_type_hash(type_name)
+        registry.get_message_class(type_name)
+        return registry.store().ros2_type_hash(type_name)
+    except (InterfaceError, KeyError, ValueError):
+        return ""
+
+
+class ZenohTransport:
+    """One Zenoh session for one domain, behind rosl's transport seam."""
+
+    def __init__(self, domain: int) -> None:
+        from rosl.bus.zenoh_config import open_session, session_config
+        from rosl.bus.zenoh_graph import ForeignGraph, LocalEntities
+
+        self.name = "the Zenoh transport"
+        self.fix_hint = (
+            "check ZENOH_SESSION_CONFIG_URI / ZENOH_CONFIG_OVERRIDE (a router: rosl zenoh router)"
+        )
+        self.domain = domain
+        self.max_datagram = MAX_DATAGRAM
+        self.pacer = pacer_from_env(True)
+        self.auth: Auth | None = (
+            None  # Zenoh authenticates links itself (TLS, user/password in its config)
+        )
+        self._closed = False
+        self.session: zenoh.Session = open_session(session_config())
+        self.zid = str(self.session.info.zid())
+        self._lock = threading.RLock()
+        self._receivers: list[ZenohReceiver] = []
+        self._routes: dict[int, _Route] = {}  # topic/service hash -> route
+        self._publishers: dict[str, Any] = {}  # key -> zenoh.Publisher
+        self._queryables: dict[str, Any] = {}
+        self._subscribers: dict[str, Any] = {}  # key -> zenoh.Subscriber
+        self._wildcard: Any = None  # the subscriber on every topic (recorders)
+        self._queries: dict[tuple[int, int, int], tuple[Any, bytes]] = {}
+        self._key_hashes: dict[str, tuple[int, int]] = {}
+        self.local = LocalEntities(self)
+        self._rosl_sub = self.session.declare_subscriber(
+            f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
+        )
+        self.foreign = ForeignGraph(self)
+        self._settle()
+
+    def _settle(self, bound_s: float = SETTLE_S) -> None:
+        """Wait (bounded) for direct links to the sessions already in the graph.
+
+        Zenoh peers exchange their subscriptions when they link up; until then, what another
+        rosl process says to this one (the answers to its first graph query) may be dropped.
+        """
+        from rosl.bus.zenoh_graph import ROSL_TOKEN
+
+        known = {self.zid}
+        for reply in self.session.liveliness().get(f"{ROSL_TOKEN}/{self.domain}/*", timeout=1.0):
+            if reply.ok is not None:
+                known.add(str(reply.ok.key_expr).rsplit("/", 1)[1])
+        known |= self.foreign.zids()
+        known.discard(self.zid)
+        deadline = time.monotonic() + bound_s
+        while known and time.monotonic() < deadline:
+            linked = {str(zid) for zid in self.session.info.peers_zid()}
+            if known <= linked:
+                time.sleep(0.05)  # their declarations follow the link at once
+                return
+            time.sleep(0.01)
+
+    # --- routes -------------------------------------------------------------------------------
+
+    def route(self, topic: int, name: str, type_name: str, service: bool) -> _Route:
+        """Learn (once) the key expression of a topic or service hash."""
+        with self._lock:
+            known = self._routes.get(topic)
+            if known is not None and known.key:
+                return known
+            digest = type_hash_of(type_name, service)
+            key = wire.topic_key(self.domain, name, type_name, digest) if digest else ""
+            known = _Route(name, type_name, key, service)
+            self._routes[topic] = known
+            return known
+
+    def register_writer(self, topic: int, name: str, type_name: str, kind: int) -> None:
+        """A writer was made (the seam's optional hook): know its key; servers get queryables."""
+        if kind == Kind.DISCOVERY:
+            return
+        service = kind in (Kind.REQUEST, Kind.RESPONSE, Kind.FAILURE)
+        route = self.route(topic, name, type_name, service)
+        if kind == Kind.RESPONSE and route.key:
+            with self._lock:
+                if route.key not in self._queryables:
+                    self._queryables[route.key] = self.session.declare_queryable(
+                        route.key, self._on_query, complete=True
+                    )
+
+    def subscribe(self, key: str) -> None:
+        """Declare a Zenoh subscriber on a data key (idempotent)."""
+        with self._lock:
+            if key not in self._subscribers and not self._closed:
+                self._subscribers[key] = self.session.declare_subscriber(key, self._on_sample)
+
+    def unsubscribe(self, key: str) -> None:
+        """Undeclare a data key's subscriber."""
+        with self._lock:
+            subscriber = self._subscribers.pop(key, None)
+        if subscriber is not None:
+            subscriber.undeclare()
+
+    def subscribe_all(self) -> None:
+        """Receive every topic of the domain (recorders and monitors)."""
+        with self._lock:
+            if self._wildcard is None and not self._closed:
+                self._wildcard = self.session.declare_subscriber(
+                    f"{self.domain}/**", self._on_sample
+                )
+
+    # --- sending --------------------------------------------------------------------------------
+
+    def send(self, channel: int, parts: Sequence[Buffer]) -> None:
+        """Map one rosl datagram onto Zenoh (see the module docstring)."""
+        data = b"".join(parts)
+        if len(data) < HEADER_SIZE or self._closed:
+            return
+        (_, _, kind, flags, _, sender, seq, topic, _, _, endpoint, _, stamp) = HEADER.unpack_from(
+            data
+        )
+        payload = memoryview(data)[HEADER_SIZE:]
+        if kind == Kind.DISCOVERY:
+            self._on_own_discovery(bytes(payload))
+        route = self._routes.get(topic)
+        routed = route is not None and route.key and not flags & Flags.LOCKSTEP
+        if routed and kind == Kind.DATA and route is not None:
+            gid = self.local.gid(sender, endpoint)
+            if flags & Flags.BATCH:
+                for number, when, record in split_records(payload):
+                    self._put(route.key, record, wire.encode_attachment(number, when, gid))
+            else:
+                self._put(route.key, payload, wire.encode_attachment(seq, stamp, gid))
+            return
+        if routed and kind == Kind.REQUEST and route is not None:
+            self._request(route, sender, endpoint, seq, stamp, payload)
+            return
+        if routed and kind in (Kind.RESPONSE, Kind.FAILURE) and flags & Flags.ADDRESSED:
+            self._reply(kind, payload)
+            return
+        try:
+            self.session.put(f"{ROSL_PREFIX}/{self.domain}/{channel}", data)
+        except Exception as err:  # zenoh.ZError: a closed session
+            if not self._closed:
+                raise BusError(f"Zenoh: cannot send: {err}") from None
+
+    def _put(self, key: str, payload: Buffer, attachment: bytes) -> None:
+        publisher = self._publishers.get(key)
+        if publisher is None:
+            with self._lock:
+                publisher = self._publishers.get(key)
+                if publisher is None:
+                    publisher = self.session.declare_publisher(key)
+                    self._publishers[key] = publisher
+        publisher.put(bytes(payload), attachment=attachment)
+
+    def _request(
+        self, route: _Route, sender: int, endpoint: int, seq: int, stamp: int, payload: Buffer
+    ) -> None:
+        import zenoh
+
+        gid = self.local.gid(sender, endpoint)
+        topic = hash_topic(route.name)
+        type_ = hash_type(route.type)
+
+        def on_reply(reply: zenoh.Reply) -> None:
+            ok = reply.ok
+            if ok is not None:
+                kind, body = Kind.RESPONSE, ok.payload.to_bytes()
+            else:
+                kind, body = Kind.FAILURE, _failure(reply.err)
+            now = time.time_ns()
+            self._deliver(
+                Delivery(
+                    kind,
+                    sender,
+                    endpoint,
+                    seq,
+                    topic,
+                    type_,
+                    now,
+                    now,
+                    memoryview(body),
+                    (sender, endpoint, seq),
+                )
+            )
+
+        self.session.get(
+            route.key, on_reply, target=zenoh.QueryTarget.ALL_COMPLETE,
+            consolidation=zenoh.ConsolidationMode.NONE, payload=bytes(payload),
+            attachment=wire.encode_attachment(seq, stamp, gid),
+        )  # fmt: skip
+
+    def _reply(self, kind: int, payload: memoryview) -> None:
+        if len(payload) < ADDRESS_SIZE:
+            return
+        process, endpoint, correlation = ADDRESS.unpack_from(payload)
+        with self._lock:
+            pending = self._queries.pop((process, endpoint, correlation), None)
+        if pending is None:
+            return  # answered already, or the query timed out
+        query, client_gid = pending
+        body = bytes(payload[ADDRESS_SIZE:])
+        if kind == Kind.FAILURE:
+            query.reply_err(body)
+        else:
+            attachment = wire.encode_attachment(correlation, time.time_ns(), client_gid)
+            query.reply(query.key_expr, body, attachment=attachment)
+        query.drop()
+
+    def _on_own_discovery(self, payload: bytes) -> None:
+        try:
+            message = json.loads(payload)
+        except ValueError:
+            return
+        if not isinstance(message, dict):
+            return
+        if message.get("op") == "hello":
+            self.local.update(message["process"])
+        elif message.get("op") == "bye":
+            self.local.update(None)
+        elif message.get("op") == "query":
+            self.foreign.answer(f"{message['sender']}:{message['qid']}")
+
+    # --- receiving ------------------------------------------------------------------------------
+
+    def _on_rosl_datagram(self, sample: zenoh.Sample) -> None:
+        channel = int(str(sample.key_expr).rsplit("/", 1)[1])
+        self.inject(channel, sample.payload.to_bytes())
+
+    def inject(self, channel: int, datagram: bytes) -> None:
+        """Hand a rosl datagram to every receiver that joined ``channel``."""
+        with self._lock:
+            receivers = [r for r in self._receivers if channel in r.channels]
+        for receiver in receivers:
+            receiver.put_datagram(datagram)
+
+    def _hashes(self, keyexpr: str) -> tuple[int, int]:
+        """Rosl's (topic, type) hashes of a data key (cached: computed once per key)."""
+        hashes = self._key_hashes.get(keyexpr)
+        if hashes is None:
+            key = wire.parse_topic_key(keyexpr)
+            hashes = (hash_topic(key.name), hash_type(key.type))
+            if len(self._key_hashes) < 65536:
+                self._key_hashes[keyexpr] = hashes
+        return hashes
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        try:
+            topic, type_ = self._hashes(str(sample.key_expr))
+            attachment = sample.attachment
+            if attachment is None:
+                return  # rmw_zenoh drops samples without one too
+            seq, stamp, gid = wire.decode_attachment(attachment.to_bytes())
+        except ValueError:
+            return
+        sender = int.from_bytes(gid[:8], "little") | 1
+        endpoint = int.from_bytes(gid[8:10], "little")
+        payload = sample.payload.to_bytes()
+        self._deliver(
+            Delivery(
+                Kind.DATA,
+                sender,
+                endpoint,
+                seq & 0xFFFFFFFF,
+                topic,
+                type_,
+                stamp,
+                time.time_ns(),
+                memoryview(payload),
+            )
+        )
+
+    def _on_query(self, query: zenoh.Query) -> None:
+        try:
+            topic, type_ = self._hashes(str(query.key_expr))
+            attachment = query.attachment
+            if attachment is None:
+                raise ValueError("no attachment")
+            seq, stamp, gid = wire.decode_attachment(attachment.to_bytes())
+        except ValueError:
+            query.reply_err(b"rosl: a request needs rmw_zenoh's attachment")
+            return
+        sender = int.from_bytes(gid[:8], "little") | 1
+        endpoint = int.from_bytes(gid[8:10], "little")
+        seq &= 0xFFFFFFFF
+        with self._lock:
+            self._queries[(sender, endpoint, seq)] = (query, gid)
+        body = query.payload.to_bytes() if query.payload is not None else b""
+        self._deliver(
+            Delivery(
+                Kind.REQUEST,
+                sender,
+                endpoint,
+                seq,
+                topic,
+                type_,
+                stamp,
+                time.time_ns(),
+                memoryview(body),
+            )
+        )
+
+    def _deliver(self, delivery: Delivery) -> None:
+        channel = channel_of(delivery.topic)
+        with self._lock:
+            receivers = [r for r in self._receivers if channel in r.channels]
+        for receiver in receivers:
+            receiver.put_delivery(delivery)
+
+    # --- the seam -------------------------------------------------------------------------------
+
+    def receiver(self) -> ZenohReceiver:
+        """A new receiver with no channel joined."""
+        receiver = ZenohReceiver(self)
+        with self._lock:
+            self._receivers.append(receiver)
+        return receiver
+
+    def forget(self, receiver: ZenohReceiver) -> None:
+        """A receiver closed."""
+        with self._lock:
+            if receiver in self._receivers:
+                self._receivers.remove(receiver)
+
+    def describe(self) -> str:
+        """Where the traffic goes."""
+        return f"Zenoh session {self.zid} (domain {self.domain})"
+
+    def close(self) -> None:
+        """Undeclare everything and close the session (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
+        for receiver in list(self._receivers):
+            receiver.close()
+        self.foreign.close()
+        self.local.update(None)
+        with contextlib.suppress(Exception):  # closing at exit: nothing left to tell
+            self.session.close()  # type: ignore[no-untyped-call]
+
+
+def _failure(err: Any) -> bytes:
+    text = "the server failed"
+    if err is not None:
+        try:
+            text = err.payload.to_string()
+        except Exception:
+            text = "the server failed (a reply error that is not text)"
+    if text.startswith("{"):
+        return text.encode()  # rosl's own failure payload (JSON)
+    return json.dumps({"error": text}).encode()
+
+
+class ZenohReceiver:
+    """Deliveries queued by Zenoh's threads; polled by the layers above."""
+
+    def __init__(self, transport: ZenohTransport) -> None:
+        self.reader = Reader(None)
+        self.channels: set[int] = set()
+        self._transport = transport
+        self._queue: collections.deque[Delivery | bytes] = collections.deque()
+        self._ready = threading.Condition()
+        self._woken = False
+        self._closed = False
+        self.dropped = 0
+
+    def join(self, channel: int) -> None:
+        """Start receiving ``channel`` (every topic when the reader wants all)."""
+        self.channels.add(channel)
+        if channel and self.reader.want_all:
+            self._transport.subscribe_all()
+
+    def leave(self, channel: int) -> None:
+        """Stop receiving ``channel``."""
+        self.channels.discard(channel)
+
+    def put_delivery(self, delivery: Delivery) -> None:
+        """Queue a message for the next poll, when this reader wants its topic."""
+        reader = self.reader
+        if (not reader.want_all and delivery.topic not in reader.wanted) or (
+            delivery.topic in reader.ignored
+        ):
+            return
+        self._put(delivery)
+
+    def put_datagram(self, datagram: bytes) -> None:
+        """Queue a rosl datagram (read by the reader at the next poll)."""
+        self._put(datagram)
+
+    def _put(self, item: Delivery | bytes) -> None:
+        with self._ready:
+            if self._closed:
+                return
+            if len(self._queue) >= QUEUE_LIMIT:
+                self.dropped += 1
+                return
+            self._queue.append(item)
+            self._ready.notify_all()
+
+    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
+        """Wait for queued messages (or a wake-up) and append them to ``out``."""
+        with self._ready:
+            if self._closed:
+                return 0
+            if not self._queue and not (channel is None and self._woken):
+                self._ready.wait(timeout)
+            if channel is None:
+                self._woken = False
+            items = list(self._queue)
+            self._queue.clear()
+        datagrams = []
+        for item in items:
+            if isinstance(item, bytes):
+                datagrams.append(item)
+            else:
+                self._count(item)
+                out.append(item)
+        if datagrams:
+            source = iter(datagrams)
+
+            def recv(size: int) -> bytes:
+                del size
+                try:
+                    return next(source)
+                except StopIteration:
+                    raise BlockingIOError from None
+
+            while self.reader.drain(recv, out):
+                pass
+        return 1 if items else 0
+
+    def _count(self, delivery: Delivery) -> None:
+        """Received and lost counts per publisher, as the reader keeps them for datagrams."""
+        if delivery.kind != Kind.DATA:
+            return
+        key = (delivery.sender, delivery.endpoint)
+        stats = self.reader.streams.get(key)
+        if stats is None:
+            stats = StreamStats(delivery.topic, last_seq=delivery.seq - 1)
+            self.reader.streams[key] = stats
+        gap = delivery.seq - stats.last_seq
+        if 1 < gap <= 1 << 16:
+            stats.lost += gap - 1
+        stats.last_seq = max(stats.last_seq, delivery.seq)
+        stats.received += 1
+        stats.last_received = delivery.received
+
+    def wake(self) -> None:
+        """Make a blocked (or the next) :meth:`poll` return."""
+        with self._ready:
+            self._woken = True
+            self._ready.notify_all()
+
+    def close(self) -> None:
+        """Stop receiving (idempotent)."""
+        with self._ready:
+            self._closed = True
+            self._queue.clear()
+            self._ready.notify_all()
+        self._transport.forget(self)
