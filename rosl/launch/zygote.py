@@ -34,6 +34,7 @@ from typing import IO, Any
 ENTRY = ("-P", "-m", "rosl.pkg.entry")
 DISABLE = "ROSL_LAUNCH_ZYGOTE"  # "0": start every node as a fresh interpreter
 _PR_SET_PDEATHSIG = 1
+ANSWER_TIMEOUT = 60.0  # its warm-up included, on a loaded machine
 _WARM_TYPES = (  # what every node builds at start (parameters, events, rosout, services)
     "rcl_interfaces/msg/ParameterEvent",
     "rcl_interfaces/msg/Log",
@@ -97,9 +98,11 @@ class Zygote:
             request = {"argv": cmd[4:], "env": env, "cwd": cwd, "hold": hold}
             socket.send_fds(self._sock, [json.dumps(request).encode() + b"\n"], [out_w, err_w])
             while True:
-                line = self._line(None)
+                line = self._line(ANSWER_TIMEOUT)
                 if line is None:
                     raise OSError("the launch zygote has ended")
+                if not line:
+                    raise OSError("the launch zygote does not answer")
                 word, _, rest = line.partition(" ")
                 if word == "pid":
                     break
@@ -309,6 +312,7 @@ def _become_child(request: dict[str, Any], fds: list[int]) -> None:
     os.environ.update(request["env"])
     if request["hold"]:
         signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # as a fresh interpreter has it
 
 
 def main(argv: list[str]) -> int:
@@ -319,7 +323,6 @@ def main(argv: list[str]) -> int:
     child = serve(sock)
     if child is None:
         return 0
-    signal.signal(signal.SIGINT, signal.default_int_handler)
     from rosl.pkg import entry
 
     sys.argv = [entry.__file__, *child]  # as `python -m rosl.pkg.entry ...` has it

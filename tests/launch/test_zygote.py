@@ -34,6 +34,7 @@ print("stdin", sys.stdin.read() == "")
 print("to stderr", file=sys.stderr)
 if os.environ.get("PROBE_WAIT"):
     try:
+        print("waiting")
         while True:
             time.sleep(0.05)
     except KeyboardInterrupt:
@@ -79,7 +80,7 @@ def test_a_launched_rosl_entry_has_its_own_environment_folder_output_and_exit(
 
     assert launch.wait_for(r"process has died \[pid \d+, exit code 3, "), launch.both()
     assert launch.wait_for(r"^\[probe-1\] to stderr$"), launch.both()
-    assert launch.wait_for(r"^\[waiting-3\] stdin True$"), launch.both()
+    assert launch.wait_for(r"^\[waiting-3\] waiting$"), launch.both()  # Ctrl-C is caught now
     assert launch.wait_for(r"process has finished cleanly"), launch.both()
     out = launch.lines()
     assert f"[probe-1] cwd {cwd}" in out, launch.both()
