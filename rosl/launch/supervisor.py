@@ -209,6 +209,15 @@ class Supervisor:
         """Start the pre-imported interpreter rosl nodes are forked from (if not yet)."""
         if self._zygote is None and not self.dry_run and zygote.wanted():
             self._zygote = zygote.Zygote()
+            # its exit reports wake the loop (data None: not a process's pipe)
+            self._selector.register(self._zygote.sock, selectors.EVENT_READ, None)
+
+    def _close_zygote(self) -> None:
+        if self._zygote is not None:
+            with contextlib.suppress(KeyError, ValueError):
+                self._selector.unregister(self._zygote.sock)
+            self._zygote.close()
+            self._zygote = None
 
     def _forked(self, spec: ProcessSpec, env: dict[str, str], hold: bool) -> Any:
         """A rosl node forked from the pre-imported zygote, or None to start it afresh."""
@@ -220,9 +229,7 @@ class Supervisor:
             assert self._zygote is not None
             return self._zygote.spawn(spec.cmd, env, spec.cwd, hold)
         except OSError:  # no zygote (it failed to start): fresh interpreters from now on
-            if self._zygote is not None:
-                self._zygote.close()
-            self._zygote = None
+            self._close_zygote()
             self._zygote_failed = True
             return None
 
@@ -479,9 +486,7 @@ class Supervisor:
                 self.shutdown("all processes have finished")  # (OnShutdown handlers run)
         finally:
             self.kill_all()
-            if self._zygote is not None:
-                self._zygote.close()
-                self._zygote = None
+            self._close_zygote()
             if installed_here:
                 self.restore_signal_handlers()
             if self._log_file is not None:
@@ -537,7 +542,13 @@ class Supervisor:
         )  # fmt: skip
         self._signal(running, following)
 
-    def _read(self, pipe: IO[bytes], running: Running) -> None:
+    def _read(self, pipe: IO[bytes], running: Running | None) -> None:
+        if running is None:  # the zygote reports exits
+            if self._zygote is not None:
+                self._zygote.collect()
+                if self._zygote.ended:
+                    self._selector.unregister(self._zygote.sock)
+            return
         try:
             chunk = os.read(pipe.fileno(), 65536)
         except (BlockingIOError, InterruptedError):

@@ -75,7 +75,8 @@ class Zygote:
 
     def __init__(self) -> None:
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
-        self._sock = ours
+        self.sock = ours
+        self.ended = False  # it has closed its end (and its children are gone with it)
         self._buffer = b""
         self._processes: dict[int, ZygoteProcess] = {}
         self.env = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -96,7 +97,7 @@ class Zygote:
         err_r, err_w = os.pipe()
         try:
             request = {"argv": cmd[4:], "env": env, "cwd": cwd, "hold": hold}
-            socket.send_fds(self._sock, [json.dumps(request).encode() + b"\n"], [out_w, err_w])
+            socket.send_fds(self.sock, [json.dumps(request).encode() + b"\n"], [out_w, err_w])
             while True:
                 line = self._line(ANSWER_TIMEOUT)
                 if line is None:
@@ -123,10 +124,12 @@ class Zygote:
     def _line(self, timeout: float | None) -> str | None:
         """The next line from the zygote ('' when none came within ``timeout``; None at EOF)."""
         while b"\n" not in self._buffer:
-            ready, _, _ = select.select([self._sock], [], [], timeout)
+            if self.sock.fileno() < 0:  # closed by close()
+                return None
+            ready, _, _ = select.select([self.sock], [], [], timeout)
             if not ready:
                 return ""
-            chunk = self._sock.recv(65536)
+            chunk = self.sock.recv(65536)
             if not chunk:
                 return None
             self._buffer += chunk
@@ -144,6 +147,7 @@ class Zygote:
         while True:
             line = self._line(timeout)
             if line is None:  # the zygote is gone: so are its children (parent-death signal)
+                self.ended = True
                 for process in self._processes.values():
                     process.returncode = -signal.SIGKILL
                 self._processes.clear()
@@ -158,7 +162,7 @@ class Zygote:
     def close(self) -> None:
         """End the zygote (its children, if any are left, get their parent-death signal)."""
         with contextlib.suppress(OSError):
-            self._sock.close()
+            self.sock.close()
         if self.popen.poll() is None:
             with contextlib.suppress(ProcessLookupError):
                 self.popen.kill()
