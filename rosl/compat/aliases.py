@@ -8,7 +8,6 @@ run``/``launch``) force the aliases, since a real rclpy would talk DDS, not rosl
 from __future__ import annotations
 
 import importlib
-import importlib.abc
 import importlib.machinery
 import importlib.util
 import sys
@@ -16,6 +15,9 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import types
+    from importlib.abc import Loader as LoaderBase
+else:
+    LoaderBase = object  # importlib.abc costs an import of ~6 ms; a loader needs no base
 
 ALIASES: dict[str, str] = {
     "rclpy": "rosl.compat.rclpy",
@@ -34,7 +36,7 @@ ALIASES: dict[str, str] = {
 }
 
 
-class _AliasLoader(importlib.abc.Loader):
+class _AliasLoader(LoaderBase):
     def __init__(self, target: str) -> None:
         self.target = target
 
@@ -48,7 +50,7 @@ class _AliasLoader(importlib.abc.Loader):
                 setattr(module, key, value)
 
 
-class AliasFinder(importlib.abc.MetaPathFinder):
+class AliasFinder:  # a meta path finder
     """Serve ``rclpy.*`` from ``rosl.compat.rclpy.*``."""
 
     def __init__(self) -> None:

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.machinery
 import sys
 import threading
 import types
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 # imported up front: importing them from inside find_spec, while another module is half
 # imported (copy imports org.python.core), would re-enter that half-built module
 from rosl.idl import search_path
+
+if TYPE_CHECKING:
+    from importlib.abc import Loader as LoaderBase
+else:
+    LoaderBase = object  # importlib.abc costs an import of ~6 ms; a loader needs no base
 
 _KINDS = ("msg", "srv", "action")
 _busy = threading.local()  # set while the finder itself imports or scans
@@ -48,7 +52,7 @@ class InterfaceModule(types.ModuleType):
         return registry.list_types(self.__rosl_package__, self.__rosl_kind__)
 
 
-class _Loader(importlib.abc.Loader):
+class _Loader(LoaderBase):
     def __init__(self, package: str, kind: str | None) -> None:
         self.package = package
         self.kind = kind
@@ -80,7 +84,7 @@ def _is_real(spec: importlib.machinery.ModuleSpec | None) -> bool:
     return spec is not None and spec.origin not in (None, "namespace")
 
 
-class InterfaceFinder(importlib.abc.MetaPathFinder):
+class InterfaceFinder:  # a meta path finder
     """Serve ``<pkg>`` and ``<pkg>.msg``/``.srv``/``.action`` for interface packages.
 
     It sits just before the standard path finder and defers to any real module of the same

@@ -24,16 +24,19 @@ from collections.abc import Callable, Mapping
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from rosl.idl.base import ActionType, Message, ServiceType
 from rosl.idl.errors import FieldError
+from rosl.idl.lazy_numpy import is_numpy
 from rosl.idl.names import did_you_mean, parse_type_name
 from rosl.idl.parser import FLOATS, INTEGER_RANGES, ArrayKind, FieldType
-from rosl.idl.sequences import SequenceArray, sequence_property
+from rosl.idl.sequences import array_types, sequence_property
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from rosl.idl.parser import MessageSpec
+else:
+    from rosl.idl.lazy_numpy import np  # loaded by the first numeric array
 
 __all__ = [
     "ActionType",
@@ -46,26 +49,25 @@ __all__ = [
     "to_dict",
 ]
 
-DTYPES: dict[str, Any] = {
-    "bool": np.bool_,
-    "char": np.uint8,
-    "int8": np.int8,
-    "uint8": np.uint8,
-    "int16": np.int16,
-    "uint16": np.uint16,
-    "int32": np.int32,
-    "uint32": np.uint32,
-    "int64": np.int64,
-    "uint64": np.uint64,
-    "float32": np.float32,
-    "float64": np.float64,
+DTYPES: dict[str, str] = {  # numpy dtype names
+    "bool": "bool",
+    "char": "uint8",
+    "int8": "int8",
+    "uint8": "uint8",
+    "int16": "int16",
+    "uint16": "uint16",
+    "int32": "int32",
+    "uint32": "uint32",
+    "int64": "int64",
+    "uint64": "uint64",
+    "float32": "float32",
+    "float64": "float64",
 }
 _ZERO: dict[str, Any] = {"bool": False, "string": "", **dict.fromkeys(FLOATS, 0.0)}
 DUMMY_FIELD = "structure_needs_at_least_one_member"
 
 
 _BYTES = tuple(bytes((i,)) for i in range(256))  # each byte value once, shared
-_ARRAYS = (np.ndarray, SequenceArray)
 
 
 def _scalar_default(ftype: FieldType, default: Any) -> Any:
@@ -87,7 +89,9 @@ def to_byte(value: Any, where: str) -> bytes:
     """
     if isinstance(value, (bytes, bytearray)) and len(value) == 1:
         return _BYTES[value[0]]
-    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+    if (isinstance(value, int) or is_numpy(value, "integer")) and not (
+        isinstance(value, bool) or is_numpy(value, "bool_")
+    ):
         if -128 <= value <= 255:
             return _BYTES[int(value) & 0xFF]
     elif isinstance(value, str) and len(value) == 1 and ord(value) <= 255:
@@ -109,7 +113,7 @@ def byte_array_coercer(ftype: FieldType, where: str) -> Callable[[Any], list[byt
             items = [_BYTES[0]] * (ftype.size if ftype.array is ArrayKind.FIXED else 0)
         elif isinstance(value, (bytes, bytearray, memoryview)):
             items = [_BYTES[b] for b in bytes(value)]
-        elif isinstance(value, np.ndarray) and value.ndim == 1 and value.dtype.kind in "iu":
+        elif is_numpy(value, "ndarray") and value.ndim == 1 and value.dtype.kind in "iu":
             if value.size and (int(value.min()) < -128 or int(value.max()) > 255):
                 raise FieldError(f"{where}: values must lie in 0 to 255 for byte")
             items = [_BYTES[b] for b in value.astype(np.int64).astype(np.uint8).tobytes()]
@@ -125,15 +129,19 @@ def byte_array_coercer(ftype: FieldType, where: str) -> Callable[[Any], list[byt
 
 def array_coercer(ftype: FieldType, where: str) -> Callable[[Any], Any]:
     """Return a function turning user values into a numpy array for a numeric array field."""
-    dtype = np.dtype(DTYPES[ftype.base])
+    dtype_name = DTYPES[ftype.base]
+    dtype: Any = None  # numpy's, at the first value (building the class does not load numpy)
     kinds = "b" if ftype.base == "bool" else "iu" if ftype.base in INTEGER_RANGES else "biuf"
     low, high = INTEGER_RANGES.get(ftype.base, (0, 0))
     eight_bit = ftype.base in ("uint8", "char")
 
     def coerce(value: Any) -> Any:
+        nonlocal dtype
+        if dtype is None:
+            dtype = np.dtype(dtype_name)
         if value is None:
             return np.zeros(ftype.size if ftype.array is ArrayKind.FIXED else 0, dtype)
-        if type(value) in _ARRAYS and value.dtype == dtype and value.ndim == 1:
+        if type(value) in array_types() and value.dtype == dtype and value.ndim == 1:
             array = value.view(np.ndarray)
             if not array.flags.writeable:  # a view into received bytes: a copy the user may change
                 array = array.copy()
@@ -394,11 +402,11 @@ def to_plain(value: Any) -> Any:
     """Convert one field value to plain Python data."""
     if isinstance(value, Message):
         return to_dict(value)
-    if isinstance(value, np.ndarray):
+    if is_numpy(value, "ndarray"):
         return value.tolist()
     if isinstance(value, list):
         return [to_plain(v) for v in value]
-    if isinstance(value, np.generic):
+    if is_numpy(value, "generic"):
         return value.item()
     return value
 
@@ -502,7 +510,9 @@ def convert_scalar(ftype: FieldType, value: Any, where: str) -> Any:
             return bool(value)
         raise FieldError(f"{where}: expects a bool (true/false), got {_show(value)}")
     if base in FLOATS:
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+        if isinstance(value, bool) or not (
+            isinstance(value, (int, float)) or is_numpy(value, "number")
+        ):
             raise FieldError(f"{where}: expects a {base} number, got {_show(value)}")
         return float(value)
     if base == "byte":
@@ -510,7 +520,7 @@ def convert_scalar(ftype: FieldType, value: Any, where: str) -> Any:
     # integers
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+    if isinstance(value, bool) or not (isinstance(value, int) or is_numpy(value, "integer")):
         raise FieldError(f"{where}: expects a whole number ({base}), got {_show(value)}")
     low, high = INTEGER_RANGES[base]
     if not low <= int(value) <= high:

@@ -12,10 +12,10 @@ import sys
 from collections import OrderedDict
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 import yaml
 
 from rosl.idl.errors import InterfaceError
+from rosl.idl.lazy_numpy import is_numpy
 from rosl.idl.messages import Message
 from rosl.idl.parser import ArrayKind, FieldType
 
@@ -68,14 +68,14 @@ def _convert(
         if truncate is not None and len(value) > truncate:
             return value[:truncate] + "..."
         return value
-    if isinstance(value, (list, tuple, np.ndarray)):
+    if isinstance(value, (list, tuple)) or is_numpy(value, "ndarray"):
         if no_arr and ftype is not None:
             return _array_placeholder(value, ftype)
-        items = value.tolist() if isinstance(value, np.ndarray) else list(value)
+        items = value.tolist() if is_numpy(value, "ndarray") else list(value)
         if truncate is not None and len(items) > truncate:
             return [_convert(v, None, truncate, no_arr, no_str) for v in items[:truncate]] + ["..."]
         return [_convert(v, None, truncate, no_arr, no_str) for v in items]
-    if isinstance(value, np.generic):
+    if is_numpy(value, "generic"):
         return value.item()
     if isinstance(value, Message):
         return message_to_ordered(value, truncate_length=truncate, no_arr=no_arr, no_str=no_str)
@@ -140,7 +140,7 @@ def value_to_plain(value: Any, *, truncate_length: int | None = None) -> Any:
 def _csv_text(
     value: Any, ftype: FieldType | None, truncate: int | None, no_arr: bool, no_str: bool
 ) -> str:
-    if isinstance(value, (list, tuple, np.ndarray)):
+    if isinstance(value, (list, tuple)) or is_numpy(value, "ndarray"):
         if no_arr and ftype is not None:
             return _array_placeholder(value, ftype)
         parts: list[str] = []
@@ -161,7 +161,7 @@ def _csv_text(
         if truncate is not None and len(value) > truncate:
             value = value[:truncate] + b"..."
         return str(value)
-    if isinstance(value, np.generic):
+    if is_numpy(value, "generic"):
         value = value.item()
     return str(value)
 

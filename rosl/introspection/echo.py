@@ -256,6 +256,7 @@ def echo(
     from rosl.idl.registry import get_message_class
 
     parts = field_parts(options.field)
+    node = session.node()  # first: its participant then answers the graph query too
     if type_name is None and topic not in session.graph().topics():
         yield unpublished_warning(topic)  # then ros2's error, from resolve_type
     resolved = resolve_type(session, topic, type_name)
@@ -266,7 +267,6 @@ def echo(
     if qos is None:
         qos, notes = matched_qos(session.graph().endpoints(PUBLISHER, topic))
         yield from notes
-    node = session.node()
     inbox: list[tuple[Any, dict[str, Any]]] = []
     subscription = node.create_subscription(
         msg_type, topic, lambda m, info: inbox.append((m, info)), qos, raw=options.raw

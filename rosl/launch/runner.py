@@ -96,6 +96,8 @@ def launch(
         os.environ.setdefault("PYTHONUNBUFFERED", "1")
         chosen.loading = not chosen.stopping  # a Ctrl-C from here on ends the loading at once
         try:
+            if _starts_nodes(path):  # the zygote warms up while the launch file loads
+                chosen.prepare_zygote()
             description = load_description(path)
             check_required_arguments(description, context, path)
             process(description.entities, context)
@@ -112,6 +114,15 @@ def launch(
         return 130 if chosen.interrupted_while_loading else code
     finally:
         chosen.restore_signal_handlers()
+
+
+def _starts_nodes(path: Path) -> bool:
+    """Whether a launch file looks as if it starts ROS nodes (Node, <node>, node:)."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    return "node" in text.lower()
 
 
 def start_recorder(supervisor: Supervisor, folder: Path) -> None:

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, cast
 
+from rosl.launch import zygote
 from rosl.launch.parameter_files import ParameterFiles
 from rosl.launch.records import ExecutionComplete, ProcessEvent, ProcessSpec, ShutdownEvent
 from rosl.pkg import interrupts
@@ -113,6 +114,8 @@ class Supervisor:
         self._requests: list[tuple[str, float]] = []  # shutdowns asked for by other threads
         self._entities: list[tuple[list[Any], LaunchContext]] = []  # from other threads too
         self._soon: collections.deque[Callable[[], None]] = collections.deque()  # other threads'
+        self._zygote: zygote.Zygote | None = None
+        self._zygote_failed = False
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -176,7 +179,7 @@ class Supervisor:
             env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
         hold = interrupts.HELD in env
         try:
-            popen = subprocess.Popen(
+            popen = self._forked(spec, env, hold) or subprocess.Popen(
                 spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
                 preexec_fn=lambda: _prepare_child(hold),
@@ -201,6 +204,34 @@ class Supervisor:
         if context is not None:  # handlers see it from the loop, as launch's event queue has it:
             self._started.append((started, context))  # also those registered after the action
         return label
+
+    def prepare_zygote(self) -> None:
+        """Start the pre-imported interpreter rosl nodes are forked from (if not yet)."""
+        if self._zygote is None and not self.dry_run and zygote.wanted():
+            self._zygote = zygote.Zygote()
+            # its exit reports wake the loop (data None: not a process's pipe)
+            self._selector.register(self._zygote.sock, selectors.EVENT_READ, None)
+
+    def _close_zygote(self) -> None:
+        if self._zygote is not None:
+            with contextlib.suppress(KeyError, ValueError):
+                self._selector.unregister(self._zygote.sock)
+            self._zygote.close()
+            self._zygote = None
+
+    def _forked(self, spec: ProcessSpec, env: dict[str, str], hold: bool) -> Any:
+        """A rosl node forked from the pre-imported zygote, or None to start it afresh."""
+        base = None if self._zygote is None else self._zygote.env
+        if self._zygote_failed or not zygote.can_fork(spec.cmd, env, base):
+            return None
+        try:
+            self.prepare_zygote()
+            assert self._zygote is not None
+            return self._zygote.spawn(spec.cmd, env, spec.cwd, hold)
+        except OSError:  # no zygote (it failed to start): fresh interpreters from now on
+            self._close_zygote()
+            self._zygote_failed = True
+            return None
 
     def wait_for_line(self, label: str, text: str, timeout: float) -> bool:
         """Supervise until process ``label`` prints a line containing ``text`` (bounded)."""
@@ -455,6 +486,7 @@ class Supervisor:
                 self.shutdown("all processes have finished")  # (OnShutdown handlers run)
         finally:
             self.kill_all()
+            self._close_zygote()
             if installed_here:
                 self.restore_signal_handlers()
             if self._log_file is not None:
@@ -510,7 +542,13 @@ class Supervisor:
         )  # fmt: skip
         self._signal(running, following)
 
-    def _read(self, pipe: IO[bytes], running: Running) -> None:
+    def _read(self, pipe: IO[bytes], running: Running | None) -> None:
+        if running is None:  # the zygote reports exits
+            if self._zygote is not None:
+                self._zygote.collect()
+                if self._zygote.ended:
+                    self._selector.unregister(self._zygote.sock)
+            return
         try:
             chunk = os.read(pipe.fileno(), 65536)
         except (BlockingIOError, InterruptedError):

@@ -12,8 +12,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from rosl.node.errors import RosArgsError
 from rosl.node.names import Remap
 
@@ -146,6 +144,8 @@ def _param(text: str) -> tuple[str | None, str, Any]:
 
 def parse_value(text: str) -> Any:
     """Parse a parameter value as YAML (``1`` int, ``1.0`` double, ``true`` bool, lists)."""
+    import yaml  # only when a value is given: a node's start-up stays without it
+
     try:
         value = yaml.safe_load(text) if text.strip() else ""
     except yaml.YAMLError:
@@ -195,6 +195,8 @@ def params_from_file(
         RosArgsError: not YAML, not in the ``node: {ros__parameters: {...}}`` layout, or
             (``required``) nothing for the node.
     """
+    import yaml
+
     try:
         data = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
     except OSError as err:
