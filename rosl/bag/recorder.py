@@ -153,6 +153,7 @@ class Recorder:
         self.participant = Participant(self.domain)
         self._schemas = Schemas(self.participant, self._log)
         self._node_index = self.participant.add_node(self._describe)
+        self.participant.graph.listeners.append(self._learn_names)
         if self.selection.topics is None or self.services:
             self.participant.listen_all()
         else:
@@ -379,18 +380,30 @@ class Recorder:
             return self._record_service(delivery)
         return True
 
+    def _learn_names(self) -> bool:
+        """Remember the name and type of every endpoint the graph shows (after each change).
+
+        Called on discovery's thread as the change happens, so a process that announces itself
+        and leaves before the recording thread reaches its messages still has them named.
+        """
+        participant = self.participant
+        if participant is None or participant.closed:
+            return False
+        names: dict[tuple[int, int], tuple[str, str, str]] = {}
+        for _node, endpoint in participant.graph.endpoints():
+            key = (topic_hash(endpoint.name), type_hash(endpoint.type))
+            qos = endpoint.qos if endpoint.kind == PUBLISHER else {}
+            if key not in names or qos:
+                names[key] = (endpoint.name, endpoint.type, endpoint.kind)
+        self._names = {**self._names, **names}  # one assignment: the recording thread reads it
+        return True
+
     def _resolve(self, delivery: Delivery, kinds: tuple[str, ...]) -> tuple[str, str, str] | None:
         assert self.participant is not None
-        graph = self.participant.graph
-        if graph.generation != self._generation:
-            self._generation = graph.generation
-            self._names = {}
-            for node, endpoint in graph.endpoints():
-                key = (topic_hash(endpoint.name), type_hash(endpoint.type))
-                qos = endpoint.qos if endpoint.kind == PUBLISHER else {}
-                if key not in self._names or qos:
-                    self._names[key] = (endpoint.name, endpoint.type, endpoint.kind)
-                del node
+        generation = self.participant.graph.generation
+        if generation != self._generation:  # also changes made before the listener was added
+            self._generation = generation
+            self._learn_names()
         found = self._names.get((delivery.topic, delivery.type))
         if found is None or found[2] not in kinds:
             return None
