@@ -8,9 +8,33 @@ from rosl.executor import Executor, Future, SingleThreadedExecutor
 from rosl.node.context import Context, default_context
 
 if TYPE_CHECKING:
+    from types import TracebackType
+
     from rosl.node.node import Node
 
 _global_executor: Executor | None = None
+
+
+class InitContextManager:
+    """What ``init`` returns: ``with rclpy.init():`` shuts the context down on leaving.
+
+    rclpy since Jazzy returns such an object; Humble returns None, and code that ignores the
+    value works with either.
+    """
+
+    def __init__(self, context: Context) -> None:
+        self.context = context
+
+    def __enter__(self) -> InitContextManager:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        shutdown(context=self.context)
 
 
 def init(
@@ -19,7 +43,7 @@ def init(
     context: Context | None = None,
     domain_id: int | str | None = None,
     callback_errors: str = "log",
-) -> None:
+) -> InitContextManager:
     """Initialize rosl (rclpy.init): read ``--ros-args`` from ``args`` (default sys.argv).
 
     Args:
@@ -31,6 +55,7 @@ def init(
     ctx = context or default_context
     ctx.init(args, domain_id=domain_id)
     ctx.callback_errors = callback_errors
+    return InitContextManager(ctx)
 
 
 def ok(*, context: Context | None = None) -> bool:

@@ -585,6 +585,28 @@ class Node:
         """Unregister such a callback."""
         self._parameters.remove_callback(callback)
 
+    def add_pre_set_parameters_callback(
+        self, callback: Callable[[list[Parameter]], list[Parameter]]
+    ) -> None:
+        """Register a callback that may change the list of parameters about to be set."""
+        self._parameters.add_pre_set_callback(callback)
+
+    def remove_pre_set_parameters_callback(
+        self, callback: Callable[[list[Parameter]], list[Parameter]]
+    ) -> None:
+        """Unregister such a callback."""
+        self._parameters.remove_pre_set_callback(callback)
+
+    def add_post_set_parameters_callback(self, callback: Callable[[list[Parameter]], None]) -> None:
+        """Register a callback told of the parameters once they were set."""
+        self._parameters.add_post_set_callback(callback)
+
+    def remove_post_set_parameters_callback(
+        self, callback: Callable[[list[Parameter]], None]
+    ) -> None:
+        """Unregister such a callback."""
+        self._parameters.remove_post_set_callback(callback)
+
     def describe_parameter(self, name: str) -> Any:
         """An rcl_interfaces/msg/ParameterDescriptor."""
         return self._parameters.descriptor(name).to_msg(name, self.get_parameter(name).type_)

@@ -308,6 +308,8 @@ class ParameterStore:
         self._values: dict[str, Parameter] = {}
         self._descriptors: dict[str, Descriptor] = {}
         self._callbacks: list[Callback] = []
+        self._pre_callbacks: list[Callback] = []
+        self._post_callbacks: list[Callback] = []
         self._on_event = on_event
         self._lock = threading.RLock()
         # told when an on-set callback raises (the change then fails); None: the error propagates
@@ -405,9 +407,40 @@ class ParameterStore:
         """Unregister an on-set callback."""
         self._callbacks.remove(callback)
 
+    def add_pre_set_callback(self, callback: Callback) -> None:
+        """Register a pre-set callback: it gets the list to set and returns the list to set."""
+        self._pre_callbacks.insert(0, callback)
+
+    def remove_pre_set_callback(self, callback: Callback) -> None:
+        """Unregister a pre-set callback."""
+        self._pre_callbacks.remove(callback)
+
+    def add_post_set_callback(self, callback: Callback) -> None:
+        """Register a post-set callback: told the parameters once they are set."""
+        self._post_callbacks.insert(0, callback)
+
+    def remove_post_set_callback(self, callback: Callback) -> None:
+        """Unregister a post-set callback."""
+        self._post_callbacks.remove(callback)
+
     def set(self, params: Sequence[Parameter], atomically: bool = False) -> list[SetResult]:
-        """Set parameters, each on its own (or all or nothing when ``atomically``)."""
+        """Set parameters, each on its own (or all or nothing when ``atomically``).
+
+        Pre-set callbacks may change the list first (one result per parameter of the changed
+        list); post-set callbacks hear each change that was made.
+        """
         with self._lock:
+            for pre in list(self._pre_callbacks):
+                params = list(pre(list(params)))
+            if not params and self._pre_callbacks:
+                return [
+                    SetResult(
+                        False,
+                        "parameter list cannot be empty, this might be due "
+                        "to pre_set_parameters_callback modifying the original "
+                        "parameters list.",
+                    )
+                ]
             if atomically:
                 checked = [self._prepare(p) for p in params]
                 failure = next((r for r, _ in checked if not r.successful), None)
@@ -416,6 +449,7 @@ class ParameterStore:
                 if failure is not None:
                     return [failure]
                 self._commit([p for _, p in checked])
+                self._run_post_callbacks([p for _, p in checked])
                 return [SetResult(True)]
             results = []
             for param in params:
@@ -426,8 +460,13 @@ class ParameterStore:
                         result = refused
                     else:
                         self._commit([ready])
+                        self._run_post_callbacks([ready])
                 results.append(result)
             return results
+
+    def _run_post_callbacks(self, params: list[Parameter]) -> None:
+        for callback in list(self._post_callbacks):
+            callback(params)
 
     def _prepare(self, param: Parameter) -> tuple[SetResult, Parameter]:
         name = param.name

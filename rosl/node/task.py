@@ -19,6 +19,8 @@ if TYPE_CHECKING:
 
 T = TypeVar("T")
 
+_driving = threading.local()  # .task: the rosl Task whose coroutine this thread is running
+
 
 class Scheduler(Protocol):
     """What a task needs of its executor: to be run again (an executor's ``_schedule``)."""
@@ -39,9 +41,11 @@ class Future(Generic[T]):
         self._lock = threading.Lock()
         self._executor = executor
 
-    def __await__(self) -> Generator[Future[T], None, T | None]:
+    def __await__(self) -> Generator[Future[T] | None, None, T | None]:
         while not self._done:
-            yield self  # the task running the coroutine resumes when this future is done
+            # a rosl Task resumes when this future is done; any other driver (an asyncio
+            # task, as in rclpy's asyncio examples) gets a bare yield and polls, as with rclpy
+            yield self if getattr(_driving, "task", None) is not None else None
         return self.result()
 
     def done(self) -> bool:
@@ -185,6 +189,8 @@ class Task(Future[T]):
                 self.set_result(result)
                 return
             self._coroutine = result
+        outer = getattr(_driving, "task", None)
+        _driving.task = self
         try:
             awaited = self._coroutine.send(None)
         except StopIteration as end:
@@ -195,6 +201,8 @@ class Task(Future[T]):
             self._coroutine = None
             self.set_exception(err)
             return
+        finally:
+            _driving.task = outer
         if isinstance(awaited, Future) and not awaited.done():
             awaited.add_done_callback(self._resume)
         else:

@@ -1090,3 +1090,37 @@ def test_a_thread_count_below_one_is_refused_as_a_user_error(ros):
 
     with pytest.raises(RoslError, match=r"num_threads >= 1, got 0"):
         MultiThreadedExecutor(num_threads=0)
+
+
+def test_an_asyncio_task_can_await_a_service_future_while_another_task_spins(ros):
+    import asyncio
+
+    from example_interfaces.srv import AddTwoInts
+
+    server = ros.Node("adder")
+    server.create_service(
+        AddTwoInts, "add", lambda req, res: setattr(res, "sum", req.a + req.b) or res
+    )
+    caller = ros.Node("caller")
+    client = caller.create_client(AddTwoInts, "add")
+    assert client.wait_for_service(timeout_sec=20.0)
+    executor = ros.SingleThreadedExecutor()
+    executor.add_node(server)
+    executor.add_node(caller)
+
+    async def spinning():
+        while True:
+            executor.spin_once(timeout_sec=0.01)
+            await asyncio.sleep(0.001)
+
+    async def call():
+        return await client.call_async(AddTwoInts.Request(a=40, b=2))
+
+    async def run():
+        spinner = asyncio.get_running_loop().create_task(spinning())
+        try:
+            return await asyncio.wait_for(call(), timeout=20.0)
+        finally:
+            spinner.cancel()
+
+    assert asyncio.run(run()).sum == 42

@@ -508,3 +508,92 @@ def test_a_namespaced_nodes_parameter_services_live_under_its_full_name(ros):
     assert ("/robot/cam/set_parameters", ["rcl_interfaces/srv/SetParameters"]) in (
         other.get_service_names_and_types()
     )
+
+
+def test_a_pre_set_callback_can_add_a_parameter_and_post_set_callbacks_hear_what_was_set(ros):
+    node = ros.Node("chained")
+    node.declare_parameter("speed", 0.0)
+    node.declare_parameter("limit", 0.0)
+    heard: list[tuple[str, float]] = []
+
+    def pre(params):  # setting speed also sets limit to twice it
+        extra = [ros.Parameter("limit", value=p.value * 2) for p in params if p.name == "speed"]
+        return list(params) + extra
+
+    def post(params):
+        heard.extend((p.name, p.value) for p in params)
+
+    node.add_pre_set_parameters_callback(pre)
+    node.add_post_set_parameters_callback(post)
+    results = node.set_parameters([ros.Parameter("speed", value=1.5)])
+
+    assert [r.successful for r in results] == [True, True]
+    assert node.get_parameter("limit").value == 3.0
+    assert heard == [("speed", 1.5), ("limit", 3.0)]
+    node.remove_pre_set_parameters_callback(pre)
+    node.remove_post_set_parameters_callback(post)
+    assert len(node.set_parameters([ros.Parameter("speed", value=1.0)])) == 1
+    assert node.get_parameter("limit").value == 3.0
+    assert len(heard) == 2
+
+
+def test_a_pre_set_callback_that_empties_the_list_fails_the_set(ros):
+    node = ros.Node("emptied")
+    node.declare_parameter("speed", 0.0)
+    node.add_pre_set_parameters_callback(lambda params: [])
+
+    [result] = node.set_parameters([ros.Parameter("speed", value=1.5)])
+
+    assert not result.successful
+    assert "parameter list cannot be empty" in result.reason
+    assert node.get_parameter("speed").value == 0.0
+
+
+def test_an_async_parameter_client_sets_lists_gets_loads_and_deletes_another_nodes_parameters(
+    ros, tmp_path
+):
+    from rclpy.parameter import parameter_value_to_python
+    from rclpy.parameter_client import AsyncParameterClient
+
+    board = ros.Node("board", allow_undeclared_parameters=True)
+    board.declare_parameter("fixed", 1)
+    asker = ros.Node("asker")
+    executor = ros.SingleThreadedExecutor()
+    executor.add_node(board)
+    executor.add_node(asker)
+    client = AsyncParameterClient(asker, "board")
+    assert client.wait_for_services(20.0)
+
+    def done(future):
+        executor.spin_until_future_complete(future, timeout_sec=15.0)
+        assert future.done()
+        return future.result()
+
+    set_result = done(client.set_parameters([ros.Parameter("count", value=10)]))
+    listed = done(client.list_parameters(["count", "fixed"], 10))
+    got = done(client.get_parameters(["count", "fixed"]))
+    types = done(client.get_parameter_types(["count"]))
+    path = tmp_path / "params.yaml"
+    path.write_text("board:\n  ros__parameters:\n    label: front\n    fixed: 7\n")
+    loaded = done(client.load_parameter_file(str(path)))
+    deleted = done(client.delete_parameters(["fixed"]))
+
+    assert [r.successful for r in set_result.results] == [True]
+    assert sorted(listed.result.names) == ["count", "fixed"]
+    assert [parameter_value_to_python(v) for v in got.values] == [10, 1]
+    assert list(types.types) == [ros.Parameter.Type.INTEGER.value]
+    assert [r.successful for r in loaded.results] == [True, True]
+    assert board.get_parameter("label").value == "front"
+    assert board.get_parameter("fixed").value == 7
+    assert [(r.successful, r.reason) for r in deleted.results] == [
+        (False, "Static parameter cannot be undeclared")
+    ]
+
+
+def test_an_async_parameter_client_does_not_find_a_node_that_is_not_there(ros):
+    from rclpy.parameter_client import AsyncParameterClient
+
+    client = AsyncParameterClient(ros.Node("asker"), "nobody")
+
+    assert not client.wait_for_services(0.5)
+    assert not client.services_are_ready()

@@ -274,3 +274,14 @@ def test_a_script_looping_over_spin_once_without_ok_ends_on_the_first_ctrl_c(spa
     assert not child.stopped_by_us, "one Ctrl-C did not end the loop (it needed a second)"
     assert "interrupted" in out, err
     assert child.returncode == 0, err
+
+
+def test_with_rclpy_init_shuts_down_when_the_block_ends(domain_id):
+    import rclpy
+
+    with rclpy.init(args=[]) as guard:
+        assert rclpy.ok()
+        node = rclpy.create_node("scoped")
+        assert node.get_name() == "scoped"
+    assert guard.context is rclpy.get_default_context()
+    assert not rclpy.ok()

@@ -50,6 +50,7 @@ _SUBMODULES = frozenset(
         "logging",
         "node",
         "parameter",
+        "parameter_client",
         "publisher",
         "qos",
         "qos_event",
