@@ -244,7 +244,11 @@ class Executor:
     def spin_until_future_complete(
         self, future: Future[Any], timeout_sec: float | None = None
     ) -> None:
-        """Spin until ``future`` is done, the timeout passes, or the context shuts down."""
+        """Spin until ``future`` is done, the timeout passes, or the context shuts down.
+
+        A Ctrl-C that ends the wait before ``future`` is done raises KeyboardInterrupt, as in
+        rclpy: the code after it reads ``future.result()``, which has nothing to give.
+        """
         future.add_done_callback(lambda _: self.wake())
         forever = timeout_sec is None or timeout_sec < 0
         deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
@@ -253,6 +257,8 @@ class Executor:
             self._spin_one(remaining, future.done)
             if deadline is not None and time.monotonic() >= deadline:
                 return
+        if not future.done() and self._context.signalled == signal.SIGINT:
+            raise KeyboardInterrupt
 
     def spin_once_until_future_complete(
         self, future: Future[Any], timeout_sec: float | None = None

@@ -276,6 +276,36 @@ def test_a_script_looping_over_spin_once_without_ok_ends_on_the_first_ctrl_c(spa
     assert child.returncode == 0, err
 
 
+WAIT_SCRIPT = """
+import rclpy
+from rclpy.node import Node
+from rclpy.task import Future
+
+rclpy.init()
+node = Node("waiter")
+never = Future()
+print("waiting", flush=True)
+try:
+    rclpy.spin_until_future_complete(node, never)
+    print("returned", never.result(), flush=True)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+node.destroy_node()
+rclpy.try_shutdown()
+"""
+
+
+def test_ctrl_c_while_spinning_until_a_future_completes_raises_keyboard_interrupt(spawn, tmp_path):
+    child = _start(spawn, tmp_path, WAIT_SCRIPT)
+    child.expect("^waiting$")
+    child.popen.send_signal(signal.SIGINT)
+    out, err = child.finish()
+    assert not child.stopped_by_us, "one Ctrl-C did not end the wait (it needed a second)"
+    assert "interrupted" in out, out + err
+    assert "returned" not in out, out + err
+    assert child.returncode == 0, err
+
+
 def test_with_rclpy_init_shuts_down_when_the_block_ends(domain_id):
     import rclpy
 
