@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import ctypes
 import datetime
 import heapq
 import itertools
@@ -44,13 +43,11 @@ if TYPE_CHECKING:
     from rosl.launch.context import LaunchContext
 
 _COLORS = ["\033[32m", "\033[34m", "\033[35m", "\033[36m", "\033[33m", "\033[92m", "\033[94m"]
-_PR_SET_PDEATHSIG = 1
 
 
 def _prepare_child(hold_sigint: bool) -> None:  # runs in the child between fork and exec
     interrupts.prepare_child(hold_sigint)
-    with contextlib.suppress(OSError, AttributeError):  # die with the launcher
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    zygote.die_with_parent()  # die with the launcher
 
 
 @dataclass(slots=True)

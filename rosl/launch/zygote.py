@@ -32,7 +32,7 @@ import time
 from typing import IO, Any
 
 ENTRY = ("-P", "-m", "rosl.pkg.entry")
-DISABLE = "ROSL_LAUNCH_ZYGOTE"  # "0": start every node as a fresh interpreter
+SWITCH = "ROSL_LAUNCH_ZYGOTE"  # "1": fork nodes from a pre-imported interpreter (opt-in)
 _PR_SET_PDEATHSIG = 1
 ANSWER_TIMEOUT = 60.0  # its warm-up included, on a loaded machine
 _WARM_TYPES = (  # what every node builds at start (parameters, events, rosout, services)
@@ -49,8 +49,8 @@ def _python_env(env: dict[str, str]) -> dict[str, str]:
 
 
 def wanted() -> bool:
-    """Whether nodes are to be forked (not when ``ROSL_LAUNCH_ZYGOTE=0``)."""
-    return os.environ.get(DISABLE) != "0"
+    """Whether nodes are to be forked (only with ``ROSL_LAUNCH_ZYGOTE=1``: opt-in for now)."""
+    return os.environ.get(SWITCH) == "1"
 
 
 def can_fork(cmd: list[str], env: dict[str, str], base: dict[str, str] | None = None) -> bool:
@@ -83,7 +83,7 @@ class Zygote:
         self.popen = subprocess.Popen(
             [sys.executable, *ENTRY[:2], "rosl.launch.zygote", str(theirs.fileno())],
             pass_fds=[theirs.fileno()], stdin=subprocess.DEVNULL, start_new_session=True,
-            env=self.env, preexec_fn=_die_with_parent,
+            env=self.env, preexec_fn=die_with_parent,
         )  # fmt: skip
         theirs.close()
 
@@ -210,9 +210,20 @@ class ZygoteProcess:
         self.send_signal(signal.SIGKILL)
 
 
-def _die_with_parent() -> None:  # between fork and exec, or in a forked node
-    with contextlib.suppress(OSError, AttributeError):
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+def _libc_prctl() -> Any:
+    try:
+        return ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+
+
+_PRCTL = _libc_prctl()  # looked up here: a forked child (maybe of a threaded parent) only calls
+
+
+def die_with_parent() -> None:
+    """SIGTERM when the parent dies (PR_SET_PDEATHSIG); safe between fork and exec."""
+    if _PRCTL is not None:
+        _PRCTL(_PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 # --- the zygote's side --------------------------------------------------------------------------
@@ -302,7 +313,7 @@ def _reap(sock: socket.socket) -> None:
 def _become_child(request: dict[str, Any], fds: list[int]) -> None:
     """Turn this fork into the node's process, as Popen and ``prepare_child`` would have."""
     os.setsid()
-    _die_with_parent()
+    die_with_parent()
     null = os.open(os.devnull, os.O_RDONLY)
     os.dup2(null, 0)
     os.close(null)

@@ -1,7 +1,7 @@
 """Nodes forked from the launcher's pre-imported interpreter behave as freshly started ones.
 
-Every check runs twice: with the zygote (the default for ``python -P -m rosl.pkg.entry``
-command lines) and with ``ROSL_LAUNCH_ZYGOTE=0`` (a fresh interpreter per node), and the
+Every check runs twice: with the zygote (``ROSL_LAUNCH_ZYGOTE=1``, for ``python -P -m
+rosl.pkg.entry`` command lines) and without it (a fresh interpreter per node), and the
 launcher's view must be the same: output prefixes on stdout and stderr, the node's own
 environment, working folder, arguments and session, exit codes, Ctrl-C.
 """
@@ -62,7 +62,7 @@ def generate_launch_description():
     ])
 """
 
-MODES = [pytest.param({}, id="zygote"), pytest.param({"ROSL_LAUNCH_ZYGOTE": "0"}, id="fresh")]
+MODES = [pytest.param({"ROSL_LAUNCH_ZYGOTE": "1"}, id="zygote"), pytest.param({}, id="fresh")]
 
 
 @pytest.mark.parametrize("env", MODES)
@@ -124,14 +124,20 @@ def test_a_node_with_its_own_pythonpath_starts_afresh_and_sees_it(
         """,
     )
 
-    code, out, err = rosl.run("launch", str(path))
+    launch = rosl.start("launch", str(path), env={"ROSL_LAUNCH_ZYGOTE": "1"})
+    code = launch.finish(60.0)
+    out, err = launch.text("out"), launch.text("err")
 
     assert code == 0, out + err
     assert "] from the extra path" in out, out + err
 
 
-def test_the_zygote_is_not_used_for_other_interpreters_or_programs() -> None:
+def test_the_zygote_is_not_used_for_other_interpreters_or_programs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     from rosl.launch import zygote
+
+    monkeypatch.setenv("ROSL_LAUNCH_ZYGOTE", "1")
 
     entry = [sys.executable, "-P", "-m", "rosl.pkg.entry", "pkg", "m:main", "name"]
     env = dict(os.environ)
@@ -139,3 +145,5 @@ def test_the_zygote_is_not_used_for_other_interpreters_or_programs() -> None:
     assert not zygote.can_fork(["/usr/bin/python3", *entry[1:]], env)
     assert not zygote.can_fork([sys.executable, "-m", "rosl", "run", "a", "b"], env)
     assert not zygote.can_fork(entry, {**env, "PYTHONPATH": "/elsewhere"})
+    monkeypatch.delenv("ROSL_LAUNCH_ZYGOTE")
+    assert not zygote.can_fork(entry, env)  # opt-in
