@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from typing import TYPE_CHECKING
 
 from rosl.bus.errors import BusError
@@ -62,7 +63,9 @@ def _insert(config: zenoh.Config, key: str, value: str, what: str) -> None:
 def _reason(err: Exception) -> str:
     """The first line of a Zenoh error, without its source location."""
     text = str(err).split(" at /", 1)[0].replace("\\n", "\n").strip()
-    return text.splitlines()[0].strip() if text else type(err).__name__
+    line = text.splitlines()[0].strip() if text else type(err).__name__
+    quoted = re.search(r'msg: "([^"]*)', line)  # Rust's debug form: Json5Err(Message { msg: "...
+    return quoted.group(1) if quoted else line
 
 
 def apply_overrides(config: zenoh.Config, overrides: str | None = None) -> zenoh.Config:
@@ -105,13 +108,19 @@ def router_config(listen: str | None = None) -> zenoh.Config:
 
 
 def open_session(config: zenoh.Config) -> zenoh.Session:
-    """Open a Zenoh session; BusError when Zenoh cannot."""
+    """Open a Zenoh session; BusError naming the endpoints when Zenoh cannot."""
     import zenoh
 
     try:
         return zenoh.open(config)
     except zenoh.ZError as err:
-        raise BusError(f"cannot open a Zenoh session: {_reason(err)}") from None
+        where = ", ".join(
+            f"{key} {config.get_json(key)}"
+            for key in ("listen/endpoints", "connect/endpoints")
+            if config.get_json(key) not in ("[]", "null", "")
+        )
+        detail = f" ({where})" if where else ""
+        raise BusError(f"cannot open a Zenoh session{detail}: {_reason(err)}") from None
 
 
 def serve_forever(session: zenoh.Session) -> None:

@@ -135,7 +135,18 @@ def test_a_bad_listen_endpoint_is_one_line(processes: Processes) -> None:
     assert child.returncode == 1
     assert len(err.strip().splitlines()) == 1
     assert "--listen: Zenoh refuses" in err
+    assert "Endpoints must be of the form" in err
+    assert "Json5Err" not in err  # Rust's debug wrapper is taken off
     assert "Traceback" not in err
+
+
+def test_an_endpoint_zenoh_cannot_open_is_named(processes: Processes) -> None:
+    child = processes.rosl("zenoh", "router", "--listen", "tcp/127.0.0.1:99999")
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == 1
+    assert len(err.strip().splitlines()) == 1
+    assert "cannot open a Zenoh session" in err
+    assert "tcp/127.0.0.1:99999" in err
 
 
 def test_a_second_router_on_a_taken_port_is_one_line(router: Router, processes: Processes) -> None:
