@@ -61,6 +61,7 @@ class _Topic:
     endpoint: int
     sequence: int = 0
     latched: bool = False  # every publisher offered transient local: its history was asked for
+    best_effort: bool = False  # a publisher offered best effort: so is the subscription (rosbag2)
     seen: set[tuple[int, int, int]] | None = None  # (sender, endpoint, seq) of a latched topic
     order: deque[tuple[int, int, int]] | None = None  # ``seen`` oldest first, to bound it
 
@@ -524,6 +525,7 @@ class Recorder:
             name, type_name, qos=self._qos(name, type_name, qos), type_hash=digest
         )
         topic = _Topic(info, encoding, text, self.participant.next_endpoint())
+        topic.best_effort = any(q.get("reliability") == "best_effort" for q in info.qos)
         self._topics[name] = topic
         if self._file is not None:  # its channel now: a topic without messages is in the file
             self._channel(self._file, name, topic)
@@ -584,7 +586,11 @@ class Recorder:
                 name,
                 t.info.type,
                 t.endpoint,
-                dict(_SUBSCRIPTION_QOS, durability="TRANSIENT_LOCAL" if t.latched else "VOLATILE"),
+                dict(
+                    _SUBSCRIPTION_QOS,
+                    durability="TRANSIENT_LOCAL" if t.latched else "VOLATILE",
+                    reliability="BEST_EFFORT" if t.best_effort else "RELIABLE",
+                ),
                 {"received": t.info.count},
             )
             for name, t in list(self._topics.items())
