@@ -252,11 +252,7 @@ class ActionClient:
 
     def _drain_feedback(self) -> None:
         """Run the feedback already received before a result: the server sent it earlier."""
-        subscription = self._feedback_sub
-        while subscription._queue:
-            work = subscription._take()
-            if work is not None:
-                work()
+        self._feedback_sub.drain()
 
     def _cancel_request(self, handle: ClientGoalHandle) -> Any:
         info = get_message_class("action_msgs/msg/GoalInfo")(goal_id=handle.goal_id)

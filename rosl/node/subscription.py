@@ -167,6 +167,17 @@ class Subscription(Queued):
                 seen.clear()
             seen[(delivery.sender, delivery.endpoint)] = delivery.received
 
+    def drain(self) -> None:
+        """Run the callback for every delivery queued now, on this thread.
+
+        For a blocking wait of rosl's own that needs what already arrived (a TF lookup with a
+        timeout, an action's feedback before its result) while no executor may be spinning.
+        """
+        while not self.destroyed and self._ready():
+            work = self._take()
+            if work is not None:
+                work()
+
     def _take(self) -> Callable[[], Any] | None:
         """Take the oldest queued delivery: the call of the callback with its message."""
         delivery = self._pop()

@@ -110,10 +110,7 @@ class TransformListener:
     def drain(self) -> None:
         """Store what the subscriptions hold now (a blocking lookup waiting calls this)."""
         for subscription in self._subscriptions:
-            while not subscription.destroyed and subscription._ready():
-                call = subscription._take()
-                if call is not None:
-                    call()
+            subscription.drain()
 
     def stopped(self) -> bool:
         """Whether the node's context was shut down (Ctrl-C): blocking waits end then."""
