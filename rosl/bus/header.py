@@ -66,6 +66,7 @@ class Flags(enum.IntFlag):
     LOCKSTEP = 2  # sent by a lock-stepped simulator: subscribers answer when they handled it
     BATCH = 4  # the payload is several small messages of one endpoint (see coalesce.py)
     SIGNED = 8  # the datagram ends with a MAC (see auth.py)
+    SHM = 16  # the payload is a descriptor of a message in shared memory (see shm.py)
 
 
 class Header(NamedTuple):

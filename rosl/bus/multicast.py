@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 from rosl.bus import auth as keys
+from rosl.bus import shm as shared
 from rosl.bus.errors import BusError
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.transport import CHANNELS
@@ -218,6 +219,8 @@ class MulticastTransport:
         self._raw: dict[int, socket.socket] = {}
         self._lock = threading.Lock()
         self.send_errors = 0
+        # large messages between processes of this host (None: ROSL_SHM=0 or no /dev/shm)
+        self.shm = shared.SharedMemory(addressing.domain) if shared.enabled() else None
 
     def send(self, channel: int, parts: Sequence[Buffer]) -> None:
         """Send one datagram; a full kernel buffer drops it (counted), never blocks."""
@@ -239,6 +242,8 @@ class MulticastTransport:
     def receiver(self) -> MulticastReceiver:
         """A new receiver (its sockets are opened as it joins channels)."""
         receiver = MulticastReceiver(self.addressing, self.auth)
+        if self.shm is not None:
+            receiver.reader.shm = self.shm.reader()
         with self._lock:
             self._receivers.append(receiver)
         return receiver
@@ -266,6 +271,8 @@ class MulticastTransport:
         for sock in raw:
             sock.close()
         self._sender.close()
+        if self.shm is not None:
+            self.shm.close()
 
 
 class MulticastReceiver:

@@ -46,6 +46,8 @@ if TYPE_CHECKING:
 
     from rosl.bus.auth import Auth
     from rosl.bus.coalesce import Flusher
+    from rosl.bus.shm import SharedMemory
+    from rosl.bus.shm_ring import RingReader
     from rosl.bus.transport import Buffer, Transport
 
 _SMALL = 2048  # below this, joining header and payload beats a scatter send
@@ -55,6 +57,7 @@ _MAGIC = hdr.MAGIC
 _ADDRESSED = int(Flags.ADDRESSED)  # plain ints: enum operators are slow per datagram
 _BATCH = int(Flags.BATCH)
 _SIGNED = int(Flags.SIGNED)
+_SHM = int(Flags.SHM)
 _DATA = int(Kind.DATA)
 _VERSION = hdr.VERSION
 
@@ -216,6 +219,9 @@ class Writer:
         self.batch: Batch | None = None
         self.auth: Auth | None = transport.auth
         self._signed = 0 if self.auth is None else _SIGNED
+        self.shm: SharedMemory | None = None  # see use_shm
+        self._shm_gate: Callable[[], bool] = _never
+        self.shm_sent = 0  # messages sent as shared-memory descriptors
         register = getattr(transport, "register_writer", None)
         if register is not None:  # a transport that routes by name (Zenoh)
             register(self.topic, name, type_name, int(kind))
@@ -223,6 +229,22 @@ class Writer:
     def coalesce(self, flusher: Flusher, limit: int) -> None:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
         self.batch = Batch(self._send_batch, min(limit, self.chunk), flusher)
+
+    def use_shm(self, gate: Callable[[], bool]) -> None:
+        """Send large messages through shared memory while ``gate()`` allows it.
+
+        ``gate()`` says whether every receiver can map this host's rings (see ``shm.py``);
+        a no-op on transports without shared memory.
+        """
+        shm = getattr(self.transport, "shm", None)
+        if shm is not None and self.kind == Kind.DATA:
+            self.shm, self._shm_gate = shm, gate
+
+    def close(self) -> None:
+        """Release what the writer holds beyond the transport (its shared-memory ring)."""
+        if self.shm is not None:
+            self.shm.drop(self.sender, self.endpoint)
+            self.shm = None
 
     def flush(self) -> None:
         """Send the small messages a coalescing writer still holds."""
@@ -278,6 +300,18 @@ class Writer:
                     self.last_seq = number
                 return number
             batch.flush()  # what is pending goes first: the stream stays in order
+        shm = self.shm
+        if (
+            shm is not None
+            and total > shm.threshold
+            and address is None
+            and kind_value == _DATA
+            and self._shm_gate()
+        ):
+            descriptor = shm.put(self.sender, self.endpoint, payload)
+            if descriptor is not None:  # else: no ring (no room): the bytes go as they are
+                payload, total, flags = descriptor, len(descriptor), flags | _SHM
+                self.shm_sent += 1
         flags |= self._signed
         if total <= self.chunk:
             head = HEADER.pack(
@@ -320,6 +354,8 @@ class Reader:
         self.unwanted = 0  # rosl datagrams of topics nobody here listens to
         self.duplicates = 0  # messages seen before (resent or replayed)
         self.stale = 0  # datagrams too old for their stream (replays), or stamped far off
+        self.shm: RingReader | None = None  # maps publishers' rings (None: shm off here)
+        self.unmappable = 0  # shared-memory descriptors with shm off here
         self.retired = 0  # streams forgotten (silent, evicted, or their process said bye)
         self.streams: dict[tuple[int, int], StreamStats] = {}  # publishers: (process, endpoint)
         # every other stream: (process, endpoint, kind, target process, target endpoint)
@@ -435,6 +471,11 @@ class Reader:
                     continue
                 if kind == _DATA:  # a server's replies to one client skip numbers by design
                     self._jumped(sender, endpoint, stats)
+            if flags & _SHM:
+                resolved = self._from_shm(sender, endpoint, payload, stats)
+                if resolved is None:
+                    continue
+                payload, flags = resolved, flags ^ _SHM
             out.append(
                 _new_tuple(
                     Delivery,
@@ -502,6 +543,20 @@ class Reader:
                       None, flags)  # fmt: skip
             out.append(_new_tuple(Delivery, fields))
 
+    def _from_shm(
+        self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap, stats: StreamStats
+    ) -> memoryview | None:
+        """The message a shared-memory descriptor names; None (counted as lost) when gone."""
+        shm = self.shm
+        data = None if shm is None else shm.read(sender, endpoint, descriptor)
+        if data is None:
+            if shm is None:
+                self.unmappable += 1
+            stats.received -= 1  # counted as received by its window: it was lost instead
+            stats.lost += 1
+            return None
+        return memoryview(data)  # read-only: the deserializer keeps array views of it
+
     # --- streams ---------------------------------------------------------------------------------
 
     def _open(
@@ -564,6 +619,9 @@ class Reader:
         gone = set()
         while self._gone:
             gone.add(self._gone.popleft())
+        if self.shm is not None:
+            for sender in gone:
+                self.shm.forget(sender)  # unmap its rings (the polling thread owns them)
         for table in (self.streams, self.others):
             for key, stats in list(table.items()):
                 if key[0] in gone or now - stats.last_received > SILENT_NS:
@@ -625,6 +683,8 @@ class Reader:
             "malformed": self.reassembler.malformed,
             "incomplete": self.reassembler.incomplete,
             "evicted": self.reassembler.evicted,
+            "overwritten": 0 if self.shm is None else self.shm.overwritten,
+            "unmapped": self.unmappable + (0 if self.shm is None else self.shm.unmapped),
         }
 
 
@@ -632,6 +692,10 @@ def _seen(stats: StreamStats, seq: int) -> bool:
     """Whether a stream already delivered ``seq`` (inside its window)."""
     back = (stats.last_seq - seq) & _MASK32
     return back < DUP_WINDOW and bool(stats.seen >> back & 1)
+
+
+def _never() -> bool:
+    return False
 
 
 def _log(line: str) -> None:

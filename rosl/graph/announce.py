@@ -198,9 +198,11 @@ class Discovery:
                 self._send({"op": "bye", "sender": f"{self.sender:016x}"})
             return
         self._has_announced = True
+        shm = getattr(self._transport, "shm", None)
         record = ProcessRecord(
-            self.sender, os.getpid(), HOST, nodes, next(self._version), lockstep=self.lockstep
-        )
+            self.sender, os.getpid(), HOST, nodes, next(self._version), lockstep=self.lockstep,
+            shm="" if shm is None else shm.host,
+        )  # fmt: skip
         known = [f"{s:016x}" for s in self.cache.senders()]
         self._send(
             {"op": "hello", "process": to_json(record), "known": known, "reply_to": reply_to}

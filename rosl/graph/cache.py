@@ -152,6 +152,19 @@ class GraphCache:
                 found[endpoint.name].add(endpoint.type)
         return {name: sorted(types) for name, types in sorted(found.items())}
 
+    def all_on_host(self, kind: str, name: str, host: str) -> bool:
+        """Whether every process with an endpoint of a kind on a name maps rings on ``host``.
+
+        See ``bus/shm.py``; True when there is no such endpoint.
+        """
+        with self._changed:
+            processes = list(self._processes.values())
+        return all(
+            p.shm == host
+            for p in processes
+            if any(e.kind == kind and e.name == name for n in p.nodes for e in n.endpoints)
+        )
+
     def count(self, kind: str, name: str) -> int:
         """How many endpoints of a kind are on a name (e.g. subscriptions of /chatter)."""
         return len(self.endpoints(kind, name))

@@ -68,6 +68,7 @@ class ProcessRecord:
     version: int
     seen: float = 0.0  # time.monotonic() of the last announcement
     lockstep: bool = False  # spins an executor that answers a lock-stepped simulator
+    shm: str = ""  # where it maps shared memory (``bus.shm.host_identity``); "": it does not
 
 
 def gid(process: int, endpoint: int) -> str:
@@ -89,6 +90,7 @@ def to_json(record: ProcessRecord) -> dict[str, Any]:
         "host": record.host,
         "version": record.version,
         "lockstep": record.lockstep,
+        "shm": record.shm,
         "nodes": [
             {
                 "name": n.name,
@@ -124,5 +126,5 @@ def from_json(data: dict[str, Any], seen: float) -> ProcessRecord:
     )
     return ProcessRecord(
         sender, int(data["pid"]), str(data["host"]), nodes, int(data["version"]), seen,
-        bool(data.get("lockstep", False)),
+        bool(data.get("lockstep", False)), str(data.get("shm", "")),
     )  # fmt: skip

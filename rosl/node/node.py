@@ -379,6 +379,7 @@ class Node:
         self.participant.remove_replayer(publisher.topic, publisher)
         if publisher._writer in self.participant.writers:
             self.participant.writers.remove(publisher._writer)
+        publisher._writer.close()  # its shared-memory ring, if it made one
         return self._remove(self.publishers, publisher)
 
     def destroy_subscription(self, subscription: Subscription) -> bool:

@@ -49,6 +49,9 @@ class Publisher:
             participant.transport, participant.sender, self.endpoint, topic, self.type_name
         )
         participant.writers.append(self._writer)
+        shm = getattr(participant.transport, "shm", None)
+        if shm is not None and shm.host:
+            self._writer.use_shm(_LocalSubscribers(node, topic, shm.host))
         if coalesce is None:
             coalesce = os.environ.get("ROSL_COALESCE", "").strip().lower() in ("1", "true", "yes")
         if coalesce:
@@ -150,6 +153,28 @@ class Publisher:
         participant.discovery.send(
             {"op": "liveliness", "sender": f"{participant.sender:016x}", "endpoint": self.endpoint}
         )
+
+
+class _LocalSubscribers:
+    """Whether every subscription of a topic is in a process that maps this host's rings.
+
+    Asked per large message; answered from the graph, again only when the graph changed.
+    """
+
+    def __init__(self, node: Node, topic: str, host: str) -> None:
+        self._graph = node.participant.graph
+        self._topic = topic
+        self._host = host
+        self._generation = -1
+        self._answer = False
+
+    def __call__(self) -> bool:
+        graph = self._graph
+        generation = graph.generation
+        if generation != self._generation:
+            self._answer = graph.all_on_host(SUBSCRIPTION, self._topic, self._host)
+            self._generation = generation  # read before asking: a later change asks again
+        return self._answer
 
 
 class _HeldByCaller(Flusher):

@@ -1,0 +1,241 @@
+"""Shared memory for large messages between processes of one host: when, where, and cleanup.
+
+Above :func:`threshold` bytes (64 KiB; ``ROSL_SHM_THRESHOLD`` changes it) a publisher whose
+matched subscribers all announced this process's :func:`host_identity` writes the message
+into its ring (:mod:`rosl.bus.shm_ring`) and sends only a small descriptor datagram, signed
+like every other (the hardened bus's key covers it). Everything else — small messages,
+service traffic, replays, and any topic with a subscriber on another host — goes over the
+wire as before. ``ROSL_SHM=0`` turns the path off (a process with it off announces no
+identity, so publishers send it the bytes).
+
+The host identity is the boot id, the network namespace (inode of ``/proc/self/ns/net``)
+and the user: a process in another network namespace counts as another host (it may be
+one, behind a veth), and another user cannot open our 0600 files.
+
+Where rings live: ``/dev/shm/rosl-u<uid>-d<domain>-p<pid>-<sender>-e<endpoint>-r<n>``,
+mode 0600, created with ``O_EXCL|O_NOFOLLOW`` and memory reserved up front; readers open
+them only when they are regular files of their own user that nobody else can read.
+
+Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
+transport closes (and at interpreter exit). A crashed process leaves its rings behind until
+the next sweep (:func:`sweep`): when any process of the user opens shared memory, then at
+most every :data:`SWEEP_S` seconds while it writes or maps rings, every ring whose owner
+(pid, process start time, pid namespace) is no longer running is unlinked. Subscribers that
+mapped it keep reading what they have (an unlinked file stays mapped).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import sys
+import threading
+import time
+import weakref
+from typing import TYPE_CHECKING
+
+from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    from rosl.bus.transport import Buffer
+
+DIRECTORY = "/dev/shm"
+THRESHOLD = 64 * 1024  # bytes; larger messages take the ring
+RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring aims for
+MIN_SLOTS, MAX_SLOTS = 4, 32
+MIN_CAPACITY = 128 * 1024
+SWEEP_S = 30.0
+STALE_PARTIAL_S = 60.0  # a file with no readable header this old is a half-made ring
+_NAME = re.compile(r"^rosl-u(\d+)-d(\d+)-p(\d+)-[0-9a-f]{16}-e\d+-r\d+$")
+_OFF = ("0", "off", "false", "no")
+
+
+def enabled(env: Mapping[str, str] | None = None) -> bool:
+    """Whether this process may use shared memory (``ROSL_SHM``, and a usable /dev/shm)."""
+    environ = os.environ if env is None else env
+    if environ.get("ROSL_SHM", "").strip().lower() in _OFF:
+        return False
+    return os.path.isdir(DIRECTORY) and os.access(DIRECTORY, os.W_OK | os.X_OK)
+
+
+def threshold(env: Mapping[str, str] | None = None) -> int:
+    """Messages larger than this many bytes take the ring (``ROSL_SHM_THRESHOLD``)."""
+    text = (os.environ if env is None else env).get("ROSL_SHM_THRESHOLD", "").strip()
+    try:
+        return max(1, int(text)) if text else THRESHOLD
+    except ValueError:
+        return THRESHOLD
+
+
+def host_identity() -> str:
+    """Boot id, network namespace and user: equal exactly where rings can be shared."""
+    try:
+        with open("/proc/sys/kernel/random/boot_id") as handle:
+            boot = handle.read().strip()
+        netns = os.stat("/proc/self/ns/net").st_ino
+    except OSError:
+        return ""  # no /proc: no way to tell hosts apart, so never share
+    return f"{boot}/{netns}/{os.geteuid()}"
+
+
+def start_time(pid: int) -> int | None:
+    """A process's start time in clock ticks since boot (None: no such process)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as handle:
+            text = handle.read()
+    except OSError:
+        return None
+    return int(text[text.rindex(b")") + 2 :].split()[19])  # field 22, after "(comm)"
+
+
+def pid_namespace(pid: int | str = "self") -> int:
+    """The inode of a process's pid namespace (0 when unknown)."""
+    try:
+        return os.stat(f"/proc/{pid}/ns/pid").st_ino
+    except OSError:
+        return 0
+
+
+def this_process() -> Owner:
+    """The owner record this process writes into its rings."""
+    pid = os.getpid()
+    return Owner(pid, start_time(pid) or 0, pid_namespace())
+
+
+def segment_name(
+    uid: int, domain: int, pid: int, sender: int, endpoint: int, incarnation: int
+) -> str:
+    """The file name of a ring (in :data:`DIRECTORY`)."""
+    return f"rosl-u{uid}-d{domain}-p{pid}-{sender:016x}-e{endpoint}-r{incarnation}"
+
+
+def _alive(owner: Owner) -> bool:
+    if owner.pid_ns and owner.pid_ns != pid_namespace():
+        return True  # another pid namespace's pid: we cannot tell, so leave it
+    return start_time(owner.pid) == owner.start_time
+
+
+def sweep(directory: str = DIRECTORY, uid: int | None = None) -> list[str]:
+    """Unlink this user's rings whose owning process is gone; return their names."""
+    user = os.geteuid() if uid is None else uid
+    removed: list[str] = []
+    me = os.getpid()
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return removed
+    for name in names:
+        match = _NAME.match(name)
+        if match is None or int(match[1]) != user or int(match[3]) == me:
+            continue
+        path = os.path.join(directory, name)
+        try:
+            info = os.lstat(path)
+        except OSError:
+            continue
+        if info.st_uid != user:
+            continue
+        owner = read_owner(path)
+        if owner is None:
+            if time.time() - info.st_mtime < STALE_PARTIAL_S:
+                continue  # being created right now
+        elif _alive(owner):
+            continue
+        with contextlib.suppress(OSError):
+            os.unlink(path)
+            removed.append(name)
+    return removed
+
+
+class SharedMemory:
+    """A transport's shared memory: its publishers' rings, readers for its receivers."""
+
+    def __init__(self, domain: int, directory: str = DIRECTORY) -> None:
+        self.domain = domain
+        self.directory = directory
+        self.host = host_identity()
+        self.threshold = threshold()
+        self.uid = os.geteuid()
+        self._owner = this_process()
+        self._rings: dict[tuple[int, int], RingWriter] = {}
+        self._lock = threading.Lock()
+        self._failed = False
+        self._next_sweep = time.monotonic() + SWEEP_S
+        self.swept = sweep(directory, self.uid)  # at start: what crashed processes left
+        self._finalizer = weakref.finalize(self, _close_rings, self._rings)
+
+    def path(self, sender: int, endpoint: int, pid: int, incarnation: int) -> str:
+        """Where the ring of one endpoint (of one process start) is."""
+        name = segment_name(self.uid, self.domain, pid, sender, endpoint, incarnation)
+        return os.path.join(self.directory, name)
+
+    def put(self, sender: int, endpoint: int, payload: Buffer) -> bytes | None:
+        """Write a message into the endpoint's ring; its descriptor, or None (send the bytes).
+
+        The ring is made on first use and made anew, bigger, when a message outgrows it.
+        """
+        if self._failed:
+            return None
+        size = len(payload)
+        with self._lock:
+            self._maybe_sweep()
+            ring = self._rings.get((sender, endpoint))
+            if ring is None or size > ring.capacity:
+                ring = self._grow(sender, endpoint, ring, size)
+                if ring is None:
+                    return None
+            return ring.put(payload)
+
+    def _grow(
+        self, sender: int, endpoint: int, old: RingWriter | None, size: int
+    ) -> RingWriter | None:
+        capacity = max(MIN_CAPACITY, 1 << (size - 1).bit_length())
+        slots = max(MIN_SLOTS, min(MAX_SLOTS, RING_BYTES // capacity))
+        incarnation = 1 if old is None else old.incarnation + 1
+        if old is not None:
+            old.close()
+        path = self.path(sender, endpoint, self._owner.pid, incarnation)
+        try:
+            ring = RingWriter(path, self._owner, incarnation, slots, capacity)
+        except OSError as err:
+            self._failed = True
+            self._rings.pop((sender, endpoint), None)
+            print(
+                f"rosl: warning: cannot make a shared-memory ring {path} ({err.strerror}); "
+                "large messages go over the network instead",
+                file=sys.stderr,
+            )
+            return None
+        self._rings[(sender, endpoint)] = ring
+        return ring
+
+    def drop(self, sender: int, endpoint: int) -> None:
+        """An endpoint is gone: unlink its ring."""
+        with self._lock:
+            ring = self._rings.pop((sender, endpoint), None)
+        if ring is not None:
+            ring.close()
+
+    def reader(self) -> RingReader:
+        """A reader for one receiver (maps rings of this user and domain on first use)."""
+        return RingReader(self.path)
+
+    def _maybe_sweep(self) -> None:
+        now = time.monotonic()
+        if now >= self._next_sweep:
+            self._next_sweep = now + SWEEP_S
+            sweep(self.directory, self.uid)
+
+    def close(self) -> None:
+        """Unlink every ring this transport made (idempotent)."""
+        with self._lock:
+            self._finalizer()
+
+
+def _close_rings(rings: dict[tuple[int, int], RingWriter]) -> None:
+    for ring in list(rings.values()):
+        ring.close()
+    rings.clear()

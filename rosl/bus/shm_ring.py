@@ -1,0 +1,258 @@
+"""The shared-memory ring of one publisher: its file layout, the writer, and the reader's maps.
+
+A large message is written into a slot of its publisher's ring (a file in ``/dev/shm``, mode
+0600) and the bus carries only a :data:`DESCRIPTOR` (pid, ring incarnation, message number,
+length) in a normal signed datagram. Subscribers of this host map the ring read-only and copy
+the message out. Policy (when to use a ring, names, cleanup) lives in :mod:`rosl.bus.shm`.
+
+Layout: page 0 holds the :data:`HEADER` (magic, slots, slot capacity, owner pid, the owner's
+process start time and pid namespace, which the cleanup pass checks) and from byte 64 one
+8-byte *generation* per slot; slot ``i``'s bytes start at page 1 + ``i * capacity``.
+
+Safety against a slow subscriber (a seqlock per slot): the writer of message ``n`` sets the
+slot's generation to ``2n - 1`` (odd: being written), copies the payload, then sets it to
+``2n``. A reader of message ``n`` checks the generation is ``2n``, copies the bytes out, and
+checks it again; any other value means the slot was (or is being) reused for a newer message:
+the read is refused and counted (``overwritten``), never delivered torn. The writer never
+waits for readers, so a subscriber that falls more than a ring behind loses the oldest
+messages, counted as loss, exactly as a full socket buffer would drop them. (The checks rely
+on stores becoming visible in program order, as on x86-64; the slot is only reused after a
+whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
+
+Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
+cannot prevent; so every read makes exactly one copy (``bytes`` of the slot, no zero-fill
+pass) and the sequence check runs after that copy. The copy is immutable, so the
+deserializer keeps numpy arrays as views of it (no second copy) and the message owns it.
+
+Hand-written because no library does this: ``multiprocessing.shared_memory`` gives a
+segment but no ring, no torn-read check, and its resource tracker unlinks segments other
+processes still use; iceoryx2, eCAL and dora ship their own rings behind their own
+transports, not a slot store next to ours.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import mmap
+import os
+import stat
+import struct
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.bus.transport import Buffer
+
+    # (sender, endpoint, pid, incarnation) -> the ring's path (see shm.py)
+    Namer = Callable[[int, int, int, int], str]
+
+MAGIC = b"RLSHM\x00\x01\x00"
+HEADER = struct.Struct("<8sIIIIQQ")  # magic, slots, capacity, pid, -, start time, pid ns
+GENERATIONS_AT = 64
+PAGE = mmap.PAGESIZE
+DATA_AT = PAGE
+MAX_SLOTS = (DATA_AT - GENERATIONS_AT) // 8
+DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
+MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
+
+
+def _round_up(value: int, step: int) -> int:
+    return -(-value // step) * step
+
+
+def segment_size(slots: int, capacity: int) -> int:
+    """Bytes of a ring file of ``slots`` slots of ``capacity`` bytes."""
+    return DATA_AT + slots * capacity
+
+
+@dataclass(frozen=True, slots=True)
+class Owner:
+    """Who made a ring: checked by the cleanup pass (a pid alone can be reused)."""
+
+    pid: int
+    start_time: int  # field 22 of /proc/<pid>/stat (clock ticks since boot)
+    pid_ns: int  # inode of /proc/<pid>/ns/pid: pids of another namespace are not ours
+
+
+def read_owner(path: str) -> Owner | None:
+    """The owner a ring file names in its header (None: not a ring, or unreadable)."""
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(HEADER.size)
+    except OSError:
+        return None
+    if len(head) < HEADER.size:
+        return None
+    magic, _slots, _capacity, pid, _, start, pid_ns = HEADER.unpack(head)
+    return Owner(pid, start, pid_ns) if magic == MAGIC else None
+
+
+class RingWriter:
+    """One publisher's ring: writes messages into slots, returns their descriptors."""
+
+    def __init__(
+        self, path: str, owner: Owner, incarnation: int, slots: int, capacity: int
+    ) -> None:
+        """Create the file (mode 0600, never an existing one) and reserve its memory.
+
+        Raises:
+            OSError: the file exists, or /dev/shm has no room (posix_fallocate says so up
+                front, instead of a SIGBUS on the first write).
+        """
+        self.path = path
+        self.incarnation = incarnation
+        self.slots = max(1, min(slots, MAX_SLOTS))
+        self.capacity = _round_up(capacity, PAGE)
+        self._pid = owner.pid
+        size = segment_size(self.slots, self.capacity)
+        flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+        fd = os.open(path, flags, 0o600)
+        try:
+            os.fchmod(fd, 0o600)  # the umask may only remove bits; make sure of the rest
+            os.posix_fallocate(fd, 0, size)
+            self._map = mmap.mmap(fd, size, mmap.MAP_SHARED, mmap.PROT_READ | mmap.PROT_WRITE)
+        except OSError:
+            os.close(fd)
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+            raise
+        os.close(fd)
+        header = HEADER.pack(
+            MAGIC, self.slots, self.capacity, owner.pid, 0, owner.start_time, owner.pid_ns
+        )
+        self._map[: HEADER.size] = header
+        self._view = memoryview(self._map)
+        self._generations = self._view[GENERATIONS_AT : GENERATIONS_AT + 8 * self.slots].cast("Q")
+        self._next = 1
+        self.closed = False
+
+    def put(self, payload: Buffer) -> bytes:
+        """Write one message into the next slot; return its descriptor (for the datagram)."""
+        size = len(payload)
+        if size > self.capacity:
+            raise ValueError(f"{size} bytes do not fit a slot of {self.capacity}")
+        number = self._next
+        self._next += 1
+        slot = number % self.slots
+        start = DATA_AT + slot * self.capacity
+        generations = self._generations
+        generations[slot] = 2 * number - 1  # odd: being written
+        self._view[start : start + size] = payload
+        generations[slot] = 2 * number
+        return DESCRIPTOR.pack(self._pid, self.incarnation, number, size)
+
+    def close(self, unlink: bool = True) -> None:
+        """Unmap the ring and (by default) remove its file (idempotent)."""
+        if self.closed:
+            return
+        self.closed = True
+        self._generations.release()
+        self._view.release()
+        self._map.close()
+        if unlink:
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+
+
+class _Mapped:
+    """One ring as a reader sees it: read-only, checked before use."""
+
+    def __init__(self, fd: int) -> None:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode) or info.st_uid != os.geteuid():
+            raise PermissionError("not a regular file of this user")
+        if info.st_mode & 0o077:
+            raise PermissionError("readable by other users")
+        if info.st_size < DATA_AT:
+            raise ValueError("too small for a ring")
+        self.map = mmap.mmap(fd, info.st_size, mmap.MAP_SHARED, mmap.PROT_READ)
+        magic, slots, capacity, *_ = HEADER.unpack_from(self.map)
+        if (
+            magic != MAGIC
+            or not 0 < slots <= MAX_SLOTS
+            or capacity <= 0
+            or segment_size(slots, capacity) != info.st_size
+        ):
+            self.map.close()
+            raise ValueError("not a ring")
+        self.slots, self.capacity = slots, capacity
+        self.view = memoryview(self.map)
+        self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
+
+    def close(self) -> None:
+        self.generations.release()
+        self.view.release()
+        self.map.close()
+
+
+class RingReader:
+    """A subscriber's side: maps rings on first use and copies messages out of their slots.
+
+    Counts what it could not read: ``overwritten`` (the slot was reused before or while it was
+    copied: a slow subscriber) and ``unmapped`` (no such ring of this user, or not a ring).
+    """
+
+    def __init__(self, name_of: Namer) -> None:
+        self._name_of = name_of
+        self._maps: OrderedDict[tuple[int, int, int, int], _Mapped] = OrderedDict()
+        self.overwritten = 0
+        self.unmapped = 0
+
+    def read(self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap) -> bytes | None:
+        """The message a descriptor names (one copy), or None (counted) when it is gone."""
+        if len(descriptor) != DESCRIPTOR.size:
+            self.unmapped += 1
+            return None
+        pid, incarnation, number, size = DESCRIPTOR.unpack(descriptor)
+        ring = self._ring((sender, endpoint, pid, incarnation))
+        if ring is None or size > ring.capacity:
+            self.unmapped += 1
+            return None
+        slot = number % ring.slots
+        expected = 2 * number
+        generations = ring.generations
+        if generations[slot] != expected:
+            self.overwritten += 1
+            return None
+        start = DATA_AT + slot * ring.capacity
+        data = bytes(ring.view[start : start + size])
+        if generations[slot] != expected:  # reused while we copied: the copy may be torn
+            self.overwritten += 1
+            return None
+        return data
+
+    def _ring(self, key: tuple[int, int, int, int]) -> _Mapped | None:
+        ring = self._maps.get(key)
+        if ring is not None:
+            self._maps.move_to_end(key)
+            return ring
+        path = self._name_of(*key)
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+        except OSError:
+            return None
+        try:
+            ring = _Mapped(fd)
+        except (OSError, ValueError, struct.error):
+            return None
+        finally:
+            os.close(fd)
+        for old in [k for k in self._maps if k[:3] == key[:3] and k[3] < key[3]]:
+            self._maps.pop(old).close()  # the ring grew: its older incarnation is done
+        if len(self._maps) >= MAX_MAPS:
+            self._maps.popitem(last=False)[1].close()
+        self._maps[key] = ring
+        return ring
+
+    def forget(self, sender: int) -> None:
+        """Unmap every ring of a process that is gone."""
+        for key in [k for k in self._maps if k[0] == sender]:
+            self._maps.pop(key).close()
+
+    def close(self) -> None:
+        """Unmap every ring."""
+        while self._maps:
+            self._maps.popitem()[1].close()

@@ -1,0 +1,215 @@
+"""The shared-memory path for large messages: rings in /dev/shm, descriptors on the bus.
+
+Real processes on the test's domain: nodes publishing large and small messages, a writer
+that fills its ring while the subscriber does not read (a slow subscriber), and one killed
+with SIGKILL (a crashed publisher, whose ring the next process removes).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import stat
+import subprocess
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pytest
+
+from rosl.bus.header import topic_hash
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.shm import DIRECTORY
+from rosl.bus.transport import channel_of
+from rosl.bus.wire import Writer
+from tests.bus import shm_snippets as snippets
+from tests.bus.helpers import Lines, wait_exit
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+    from rosl.bus.transport import Receiver
+    from rosl.bus.wire import Delivery
+    from tests.conftest import Processes
+
+TOPIC = "/shm_ring"
+SENDER, ENDPOINT = 0x5151, 7
+RING_WRITER = r"""
+import os, sys
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.wire import Writer
+
+domain, count, size = (int(a) for a in sys.argv[1:4])
+transport = MulticastTransport(Addressing(domain))
+writer = Writer(transport, 0x5151, 7, "/shm_ring", "test/msg/Bytes")
+writer.use_shm(lambda: True)
+for i in range(count):
+    writer.send(i.to_bytes(4, "little") * (size // 4))
+print("sent", writer.shm_sent, transport.shm.path(0x5151, 7, os.getpid(), 1), flush=True)
+sys.stdin.readline()  # keep the ring until told
+transport.close()
+print("closed", flush=True)
+"""
+
+
+@pytest.fixture
+def bus(domain_id: int) -> Iterator[tuple[MulticastTransport, Receiver]]:
+    """A transport of the test's domain and a receiver listening to TOPIC (closed after)."""
+    transport = MulticastTransport(Addressing(domain_id))
+    receiver = transport.receiver()
+    topic = topic_hash(TOPIC)
+    receiver.reader.wanted.add(topic)
+    receiver.join(channel_of(topic))
+    try:
+        yield transport, receiver
+    finally:
+        transport.close()
+
+
+def pattern(index: int, size: int) -> bytes:
+    return index.to_bytes(4, "little") * (size // 4)
+
+
+def ring_writer(
+    processes: Processes, domain: int, count: int, size: int
+) -> tuple[Lines, str, subprocess.Popen[str]]:
+    """A child that sends ``count`` messages of ``size`` bytes through its ring, then waits."""
+    child = processes.python(RING_WRITER, str(domain), str(count), str(size), stdin=subprocess.PIPE)
+    out = Lines(child.stdout)
+    line = out.wait_line("sent ", 30.0)
+    assert line is not None, f"the ring writer never sent: {Lines(child.stderr).rest(2.0)}"
+    _, sent, path = line.split()
+    assert int(sent) == count
+    return out, path, child
+
+
+def talk(
+    processes: Processes, count: int, listener_env: dict[str, str]
+) -> tuple[subprocess.Popen[str], Lines, list[str]]:
+    """A listener, then a talker of ``count`` rounds; every round must arrive intact.
+
+    Returns:
+        The talker, its output, and its counts of descriptors sent (image, text, small).
+    """
+    listener = processes.python(snippets.LISTENER, "shm_listener", env=listener_env)
+    heard = Lines(listener.stdout)
+    assert heard.wait_line("up", 30.0), Lines(listener.stderr).rest(2.0)
+    talker = processes.python(snippets.TALKER, str(count), "1")
+    said = Lines(talker.stdout)
+    line = said.wait_line("shm ", 60.0)
+    assert line is not None, Lines(talker.stderr).rest(2.0)
+    assert heard.wait_for(lambda lines: snippets.complete(lines, count), 30.0), heard.lines
+    assert not snippets.bads(heard.lines)
+    return talker, said, line.split()[1:]
+
+
+def test_large_messages_with_and_without_arrays_cross_through_shared_memory(
+    processes: Processes, domain_id: int
+) -> None:
+    talker, said, shm = talk(processes, 10, {})
+    assert shm == ["10", "10", "0"]  # the image and the long string as descriptors, not the small
+
+    rings = sorted(Path(DIRECTORY).glob(f"rosl-u{os.geteuid()}-d{domain_id}-p{talker.pid}-*"))
+    assert len(rings) == 2, rings  # one per publisher that sent large messages
+    for ring in rings:
+        assert stat.S_IMODE(ring.stat().st_mode) == 0o600
+    talker.send_signal(signal.SIGINT)  # a clean close unlinks them
+    assert said.wait_line("closed", 30.0), Lines(talker.stderr).rest(2.0)
+    assert wait_exit(talker, 15.0) == 0
+    assert not [ring for ring in rings if ring.exists()]
+
+
+def test_a_subscriber_without_shared_memory_gets_the_bytes(
+    processes: Processes, domain_id: int
+) -> None:
+    _, _, shm = talk(processes, 5, {"ROSL_SHM": "0"})
+    assert shm == ["0", "0", "0"]  # the listener announced no shared memory: all on the wire
+
+
+def test_a_slow_subscriber_never_reads_an_overwritten_slot(
+    processes: Processes, domain_id: int, bus: tuple[MulticastTransport, Receiver]
+) -> None:
+    _, receiver = bus
+    # the writer fills its ring three times over before this process reads anything
+    count, size = 100, 200_000
+    out, _path, child = ring_writer(processes, domain_id, count, size)
+    got: list[Delivery] = []
+    idle = 0
+    while idle < 3:
+        before = len(got)
+        receiver.poll(0.3, got)
+        idle = idle + 1 if len(got) == before else 0
+    reader = receiver.reader
+    overwritten = reader.dropped()["overwritten"]
+    indices = [int.from_bytes(bytes(d.payload[:4]), "little") for d in got]
+    for delivery, index in zip(got, indices, strict=True):
+        assert bytes(delivery.payload) == pattern(index, size), f"message {index} is torn"
+    assert got, "the newest ring of messages is still readable"
+    assert overwritten >= count - 32  # a ring of 200 KB messages has 32 slots
+    assert len(got) + overwritten == count
+    assert min(indices) >= overwritten  # only the newest survive
+    assert reader.lost() == overwritten  # counted where loss is reported
+    assert child.stdin is not None
+    child.stdin.write("\n")
+    child.stdin.flush()
+    assert out.wait_line("closed", 15.0)
+
+
+def test_a_crashed_publisher_leaves_no_ring_behind_the_next_process(
+    processes: Processes, domain_id: int
+) -> None:
+    _, crashed, victim = ring_writer(processes, domain_id, 1, 100_000)
+    _, alive, _ = ring_writer(processes, domain_id, 1, 100_000)
+    pid = victim.pid
+    name = Path(crashed).name
+    assert name.startswith(f"rosl-u{os.geteuid()}-d{domain_id}-p{pid}-"), name
+    assert stat.S_IMODE(Path(crashed).stat().st_mode) == 0o600
+    os.kill(pid, signal.SIGKILL)
+    assert wait_exit(victim, 15.0) is not None
+    assert Path(crashed).exists()  # nobody unlinked it: the process died
+    sweeper = processes.python(
+        "import sys\nfrom rosl.bus.multicast import Addressing, MulticastTransport\n"
+        "t = MulticastTransport(Addressing(int(sys.argv[1])))\n"
+        "print('swept', *t.shm.swept, flush=True)\nt.close()\n",
+        str(domain_id),
+    )
+    line = Lines(sweeper.stdout).wait_line("swept", 30.0)
+    assert line is not None, Lines(sweeper.stderr).rest(2.0)
+    assert name in line.split()
+    assert not Path(crashed).exists()
+    assert Path(alive).exists()  # a running publisher's ring is left alone
+
+
+def test_a_ring_others_can_read_is_refused_and_counted(
+    bus: tuple[MulticastTransport, Receiver],
+) -> None:
+    transport, receiver = bus
+    writer = Writer(transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
+    writer.use_shm(lambda: True)
+    writer.send(pattern(1, 100_000))
+    assert transport.shm is not None
+    ring = Path(transport.shm.path(SENDER, ENDPOINT, os.getpid(), 1))
+    ring.chmod(0o644)
+    got: list[Delivery] = []
+    while receiver.poll(2.0, got) and not receiver.reader.dropped()["unmapped"]:
+        pass
+    assert not got
+    assert receiver.reader.dropped()["unmapped"] == 1
+    assert receiver.reader.lost() == 1
+    ring.chmod(0o600)
+    writer.send(pattern(2, 100_000))
+    while not got and receiver.poll(2.0, got):
+        pass
+    assert [bytes(d.payload) for d in got] == [pattern(2, 100_000)]
+    assert writer.shm_sent == 2
+    transport.close()
+    assert not ring.exists()  # the transport's close unlinked it
+
+
+def test_shared_memory_can_be_turned_off(processes: Processes, domain_id: int) -> None:
+    child = processes.python(
+        "import sys\nfrom rosl.bus.multicast import Addressing, MulticastTransport\n"
+        "print('shm', MulticastTransport(Addressing(int(sys.argv[1]))).shm, flush=True)\n",
+        str(domain_id),
+        env={"ROSL_SHM": "off"},
+    )
+    assert Lines(child.stdout).wait_line("shm", 30.0) == "shm None"
