@@ -309,6 +309,8 @@ def plain(value: Any) -> Any:
             and not str(f.type).startswith(("ClassVar", "typing.ClassVar"))
         }
     if isinstance(value, np.ndarray):
+        if value.dtype.kind in "biuf":  # numbers: tolist() gives plain ones (fast for images)
+            return value.tolist()
         return [plain(v) for v in value.tolist()]
     if isinstance(value, (list, tuple)):
         return [plain(v) for v in value]
