@@ -9,15 +9,24 @@ coalescing small messages (opt-in: ``create_publisher(..., coalesce=True)`` or
 loss there must be 0. Last, the cost of authentication: the bus signed (the default) against
 the bus with ``ROSL_KEY=none``, interleaved run by run, as a ratio (aim: >= 0.9).
 
-    python bench/bus_throughput.py [--count N] [--runs R]
+Then the shared-memory path (``rosl/bus/shm.py``) for 1 MiB messages: rosl flat out (MB/s and
+loss), against a plain shared-memory ring + pipe in the same run (the baseline: slots in a
+/dev/shm file, indices through one pipe, credits back through another, one copy out per
+message, as rosl's reader makes; aim: ratio >= 0.5), the same messages over the wire
+(``ROSL_SHM=0``), and rosl paced at 80 % of its flat-out rate (loss must be 0).
+
+    python bench/bus_throughput.py [--count N] [--runs R] [--only-shm]
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import mmap
 import os
+import struct
 import sys
+import tempfile
 import time
 from typing import TYPE_CHECKING
 
@@ -27,6 +36,8 @@ if TYPE_CHECKING:
     from collections.abc import Iterator
 
 SIZES = [64, 1024, 60000, 1048576]
+MIB = 1048576
+SLOTS = 32  # the baseline ring's slots (as many as rosl's ring of 1 MiB messages)
 GROUP, PORT = f"239.255.{BENCH_DOMAIN}.9", 17400 + BENCH_DOMAIN + 1  # a port rosl does not use
 
 
@@ -95,6 +106,7 @@ def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) ->
 
     transport = MulticastTransport(Addressing(BENCH_DOMAIN))
     writer = Writer(transport, 1, 1, "/bench", "bench/msg/Bytes")
+    writer.use_shm(lambda: True)  # large messages through shared memory (unless ROSL_SHM=0)
     flusher = Flusher()
     if coalesce:
         writer.coalesce(flusher, DEFAULT_BYTES)
@@ -103,6 +115,8 @@ def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) ->
         start, clock = time.perf_counter(), time.perf_counter
         for n in range(count):
             due = start + n / rate
+            if due - clock() > 0.001:  # long waits sleep (a spinning publisher starves the
+                time.sleep(due - clock() - 0.0005)  # subscriber of a 2-core machine)
             while clock() < due:
                 pass
             writer.send(payload)
@@ -110,27 +124,87 @@ def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) ->
         for _ in range(count):
             writer.send(payload)
     flusher.close()
+    transport.close()
 
 
 def pub_coalesced(count: int, size: int) -> None:
     pub_bus(count, size, coalesce=True)
 
 
+def sub_shmpipe(count: int, size: int, folder: str) -> None:
+    """The baseline's reader: an index from the pipe, one copy out of the slot, a credit back."""
+    fd = os.open(os.path.join(folder, "ring"), os.O_RDONLY)
+    ring = mmap.mmap(fd, SLOTS * size, prot=mmap.PROT_READ)
+    os.close(fd)
+    print("ready", flush=True)
+    indices = os.open(os.path.join(folder, "indices"), os.O_RDONLY)
+    credits = os.open(os.path.join(folder, "credits"), os.O_WRONLY)
+    view = memoryview(ring)
+    got = 0
+    first = last = 0.0
+    while got < count:
+        data = os.read(indices, 4096)
+        if not data:
+            break
+        for (slot,) in struct.iter_unpack("<I", data):
+            copy = bytes(view[slot * size : (slot + 1) * size])
+            del copy
+            os.write(credits, b"c")
+            got += 1
+        last = time.perf_counter()
+        if not first:
+            first = last
+    print(got, last - first, 0, flush=True)
+
+
+def shmpipe(count: int, size: int) -> tuple[float, float]:
+    """The baseline, both sides: delivered messages/s and loss % (always 0: flow control)."""
+    with tempfile.TemporaryDirectory(dir="/dev/shm") as folder:
+        fd = os.open(os.path.join(folder, "ring"), os.O_RDWR | os.O_CREAT, 0o600)
+        os.posix_fallocate(fd, 0, SLOTS * size)
+        ring = mmap.mmap(fd, SLOTS * size)
+        os.close(fd)
+        os.mkfifo(os.path.join(folder, "indices"), 0o600)
+        os.mkfifo(os.path.join(folder, "credits"), 0o600)
+        child = spawn([__file__, "sub_shmpipe", str(count), str(size), folder])
+        indices = os.open(os.path.join(folder, "indices"), os.O_WRONLY)
+        credits = os.open(os.path.join(folder, "credits"), os.O_RDONLY)
+        payload, view, free = bytes(size), memoryview(ring), SLOTS
+        for n in range(count):
+            while not free:
+                free += len(os.read(credits, 4096))
+            slot = n % SLOTS
+            view[slot * size : (slot + 1) * size] = payload
+            os.write(indices, struct.pack("<I", slot))
+            free -= 1
+        got, seconds, _ = finish(child).split()
+        os.close(indices)
+        os.close(credits)
+        view.release()
+        ring.close()
+    return (int(got) / float(seconds) if float(seconds) > 0 else 0.0), 0.0
+
+
 @contextlib.contextmanager
-def key(value: str | None) -> Iterator[None]:
-    """Run the bus (both processes) with ``ROSL_KEY`` set to ``value`` (None: the default)."""
-    before = os.environ.get("ROSL_KEY")
+def env(name: str, value: str | None) -> Iterator[None]:
+    """Run the bus (both processes) with ``name`` set to ``value`` (None: unset)."""
+    before = os.environ.get(name)
     if value is None:
-        os.environ.pop("ROSL_KEY", None)
+        os.environ.pop(name, None)
     else:
-        os.environ["ROSL_KEY"] = value
+        os.environ[name] = value
     try:
         yield
     finally:
         if before is None:
-            os.environ.pop("ROSL_KEY", None)
+            os.environ.pop(name, None)
         else:
-            os.environ["ROSL_KEY"] = before
+            os.environ[name] = before
+
+
+def key(value: str | None) -> contextlib.AbstractContextManager[None]:
+    """Run the bus (both processes) with ``ROSL_KEY`` set to ``value`` (None: the default)."""
+    return env("ROSL_KEY", value)
 
 
 def measure(kind: str, count: int, size: int, rate: float = 0.0) -> tuple[float, float]:
@@ -150,7 +224,12 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--count", type=int, default=40000)
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--only-shm", action="store_true", help="60 KB vs raw, then 1 MiB shm")
     args = parser.parse_args()
+    if args.only_shm:
+        wire_60k(args.runs, args.count)
+        shm_section(args.runs)
+        return
     print(
         f"{'size':>8} {'raw msg/s':>10} {'raw MB/s':>9} {'bus msg/s':>10} {'bus MB/s':>9} "
         f"{'ratio':>6} {'loss %':>7}"
@@ -178,6 +257,7 @@ def main() -> None:
             flush=True,
         )
     print("ratio = rosl MB/s / raw MB/s at the same size (1 MiB: / raw 60 KB MB/s)")
+    print("1 MiB travels through shared memory (ROSL_SHM=0: over the wire); see the end")
     print(f"\n{'coalesced':>9} {'raw msg/s':>10} {'msg/s':>10} {'ratio':>6} {'loss %':>7}")
     for size in (64, 1024):
         count = args.count * 4
@@ -208,10 +288,58 @@ def main() -> None:
         label = f"{size}{'c' if kind == 'coalesced' else ''}"
         print(f"{label:>9} {a:>10.0f} {b:>10.0f} {a / b if b else 0.0:>6.2f}")
     print("mac cost: msg/s signed (default key) / with ROSL_KEY=none; c = coalesced")
+    shm_section(args.runs)
+
+
+def median(results: list[tuple[float, float]]) -> tuple[float, float]:
+    """The run with the median rate: (rate, its loss %)."""
+    return sorted(results)[len(results) // 2]
+
+
+def wire_60k(runs: int, count: int) -> None:
+    """60 KB messages: rosl against raw sockets (flat out), then rosl paced at 80 %."""
+    size = 60000
+    count = max(200, min(count, int(4e9 / size / 10)))
+    raw, bus = [], []
+    for _ in range(runs):  # interleaved: both see the same machine
+        raw.append(measure("raw", count, size))
+        bus.append(measure("bus", count, size))
+    (raw_rate, _), (bus_rate, loss) = median(raw), median(bus)
+    offered = 0.8 * bus_rate
+    paced = [measure("bus", max(200, int(offered * 2)), size, rate=offered) for _ in range(runs)]
+    worst = max(loss for _, loss in paced)
+    print(f"60 KB: raw {raw_rate * size / 1e6:.1f} MB/s, rosl {bus_rate * size / 1e6:.1f} MB/s "
+          f"(loss {loss:.2f} %), ratio {bus_rate / raw_rate if raw_rate else 0.0:.2f} "
+          f"(aim >= 0.7); paced at 80 %: loss {worst:.2f} % (worst of {runs})")  # fmt: skip
+
+
+def shm_section(runs: int) -> None:
+    """1 MiB messages through rosl's shared memory, against a plain shm ring + pipe."""
+    count = 2000
+    print(f"\n{'1 MiB':>22} {'msg/s':>8} {'MB/s':>8} {'loss %':>7}")
+    base, rosl = [], []
+    for _ in range(runs):  # interleaved: both see the same machine
+        base.append(shmpipe(count, MIB))
+        rosl.append(measure("bus", count, MIB))
+    with env("ROSL_SHM", "0"):
+        wire = [measure("bus", 300, MIB) for _ in range(runs)]
+    rows = [("shm ring + pipe (base)", base), ("rosl shared memory", rosl)]
+    rows.append(("rosl wire (ROSL_SHM=0)", wire))
+    for label, results in rows:
+        rate, loss = median(results)
+        print(f"{label:>22} {rate:>8.0f} {rate * MIB / 1e6:>8.1f} {loss:>7.2f}")
+    offered = 0.8 * median(rosl)[0]
+    paced = [measure("bus", count, MIB, rate=offered) for _ in range(runs)]
+    rate, worst = max(paced, key=lambda r: r[1])
+    print(f"{'rosl paced at 80 %':>22} {rate:>8.0f} {rate * MIB / 1e6:>8.1f} {worst:>7.2f}")
+    ratio = median(rosl)[0] / median(base)[0] if median(base)[0] else 0.0
+    print(f"shm ratio: rosl / shm ring + pipe = {ratio:.2f} (aim >= 0.5); "
+          f"wire / shm = {median(wire)[0] / median(rosl)[0] if median(rosl)[0] else 0.0:.2f}; "
+          "paced: the worst of the runs (aim: 0 % loss)")  # fmt: skip
 
 
 if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1].startswith(("sub_", "pub_")):
-        globals()[sys.argv[1]](int(sys.argv[2]), int(sys.argv[3]))
+        globals()[sys.argv[1]](int(sys.argv[2]), int(sys.argv[3]), *sys.argv[4:])
     else:
         main()

@@ -20,9 +20,11 @@ on stores becoming visible in program order, as on x86-64; the slot is only reus
 whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
-cannot prevent; so every read makes exactly one copy (``bytes`` of the slot, no zero-fill
-pass) and the sequence check runs after that copy. The copy is immutable, so the
-deserializer keeps numpy arrays as views of it (no second copy) and the message owns it.
+cannot prevent; so every read makes exactly one copy and the sequence check runs after that
+copy. The copy goes into a buffer of the reader's pool that nothing refers to any more
+(fresh memory costs more page faults than the copy) and is handed out as a read-only view,
+so the deserializer keeps numpy arrays as views of it (no second copy): the message owns it,
+and the buffer is used again only once no message, array or view holds it.
 
 Hand-written because no library does this: ``multiprocessing.shared_memory`` gives a
 segment but no ring, no torn-read check, and its resource tracker unlinks segments other
@@ -37,6 +39,7 @@ import mmap
 import os
 import stat
 import struct
+import sys
 from collections import OrderedDict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -57,6 +60,8 @@ DATA_AT = PAGE
 MAX_SLOTS = (DATA_AT - GENERATIONS_AT) // 8
 DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
+POOLED = 8  # buffers kept per ring size for the copies out of slots
+_UNUSED = 3  # sys.getrefcount of a pooled buffer nobody holds: the pool, the loop, the call
 
 
 def _round_up(value: int, step: int) -> int:
@@ -188,6 +193,32 @@ class _Mapped:
         self.map.close()
 
 
+class _Buffers:
+    """Buffers messages are copied into, used again once nothing refers to them any more.
+
+    A fresh megabyte costs 256 page faults, more than the copy into it; so each ring size
+    keeps a few buffers. A delivery hands out a read-only view of one; the view, and every
+    numpy array a message builds on it, holds a reference, so a buffer whose only
+    reference is this pool is free (CPython's reference count says so exactly).
+    """
+
+    def __init__(self) -> None:
+        self._pools: dict[int, list[bytearray]] = {}
+
+    def take(self, capacity: int, size: int) -> memoryview:
+        """A writable view of ``size`` bytes in a buffer nobody else holds."""
+        pool = self._pools.setdefault(capacity, [])
+        for buffer in pool:
+            if sys.getrefcount(buffer) <= _UNUSED:
+                return memoryview(buffer)
+        if len(pool) < POOLED or len(self._pools) > MAX_MAPS:
+            fresh = bytearray(capacity)
+            if len(pool) < POOLED:
+                pool.append(fresh)
+            return memoryview(fresh)
+        return memoryview(bytearray(size))  # all in use (a subscriber holds many messages)
+
+
 class RingReader:
     """A subscriber's side: maps rings on first use and copies messages out of their slots.
 
@@ -198,11 +229,14 @@ class RingReader:
     def __init__(self, name_of: Namer) -> None:
         self._name_of = name_of
         self._maps: OrderedDict[tuple[int, int, int, int], _Mapped] = OrderedDict()
+        self._buffers = _Buffers()
         self.overwritten = 0
         self.unmapped = 0
 
-    def read(self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap) -> bytes | None:
-        """The message a descriptor names (one copy), or None (counted) when it is gone."""
+    def read(
+        self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap
+    ) -> memoryview | None:
+        """The message a descriptor names (one copy, read-only), or None (counted) if gone."""
         if len(descriptor) != DESCRIPTOR.size:
             self.unmapped += 1
             return None
@@ -218,11 +252,12 @@ class RingReader:
             self.overwritten += 1
             return None
         start = DATA_AT + slot * ring.capacity
-        data = bytes(ring.view[start : start + size])
+        data = self._buffers.take(ring.capacity, size)
+        data[:size] = ring.view[start : start + size]
         if generations[slot] != expected:  # reused while we copied: the copy may be torn
             self.overwritten += 1
             return None
-        return data
+        return data[:size].toreadonly()
 
     def _ring(self, key: tuple[int, int, int, int]) -> _Mapped | None:
         ring = self._maps.get(key)

@@ -69,6 +69,9 @@ MAX_STREAMS = 8192  # streams followed at once (each kind of stream has its own 
 MAX_RETIRED = 16384  # streams forgotten but still protected against replays
 SILENT_NS = 10_000_000_000  # a stream silent this long is retired
 HOUSEKEEPING_NS = 250_000_000
+# one drain copies at most about this much out of shared memory: the copies of a poll are held
+# together, and fresh memory for each (page faults) costs more than the copy itself
+SHM_DRAIN_BYTES = 4 * 1024 * 1024
 MAX_JUMP_LOGS = 10
 _FULL = (1 << DUP_WINDOW) - 1
 _MASK32 = 0xFFFFFFFF
@@ -384,6 +387,7 @@ class Reader:
         """
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
         clock, streams, auth = time.time_ns, self.streams, self.auth
+        copied = 0  # bytes copied out of shared memory by this call
         now = clock()
         if now >= self._next_housekeeping:
             self._housekeeping(now)
@@ -476,6 +480,7 @@ class Reader:
                 if resolved is None:
                     continue
                 payload, flags = resolved, flags ^ _SHM
+                copied += len(resolved)
             out.append(
                 _new_tuple(
                     Delivery,
@@ -494,6 +499,8 @@ class Reader:
                     ),
                 )
             )
+            if copied > SHM_DRAIN_BYTES:
+                return True  # the rest stays in the socket: copies are freed before more
         return True
 
     def _unbatch(
@@ -555,7 +562,7 @@ class Reader:
             stats.received -= 1  # counted as received by its window: it was lost instead
             stats.lost += 1
             return None
-        return memoryview(data)  # read-only: the deserializer keeps array views of it
+        return data  # read-only: the deserializer keeps array views of it
 
     # --- streams ---------------------------------------------------------------------------------
 

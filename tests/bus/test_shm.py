@@ -129,8 +129,8 @@ def test_a_slow_subscriber_never_reads_an_overwritten_slot(
     processes: Processes, domain_id: int, bus: tuple[MulticastTransport, Receiver]
 ) -> None:
     _, receiver = bus
-    # the writer fills its ring three times over before this process reads anything
-    count, size = 100, 200_000
+    # the writer fills its ring more than twice before this process reads anything
+    count, size = 160, 1_000_000
     out, _path, child = ring_writer(processes, domain_id, count, size)
     got: list[Delivery] = []
     idle = 0
@@ -144,7 +144,7 @@ def test_a_slow_subscriber_never_reads_an_overwritten_slot(
     for delivery, index in zip(got, indices, strict=True):
         assert bytes(delivery.payload) == pattern(index, size), f"message {index} is torn"
     assert got, "the newest ring of messages is still readable"
-    assert overwritten >= count - 32  # a ring of 200 KB messages has 32 slots
+    assert overwritten >= count - 64  # a ring of 1 MB messages has 64 slots
     assert len(got) + overwritten == count
     assert min(indices) >= overwritten  # only the newest survive
     assert reader.lost() == overwritten  # counted where loss is reported
