@@ -22,9 +22,11 @@ whole ring of newer messages, which bounds the window on weaker CPUs to that lap
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
 copy. The copy goes into a buffer of the reader's pool that nothing refers to any more
-(fresh memory costs more page faults than the copy) and is handed out as a read-only view,
-so the deserializer keeps numpy arrays as views of it (no second copy): the message owns it,
-and the buffer is used again only once no message, array or view holds it.
+(fresh memory costs more page faults than the copy) and is handed out as a read-only view:
+``np.frombuffer`` wraps it without a copy, the recorder writes it as it is, and the buffer is
+used again only once no delivery, array or view holds it. (Decoded messages still give each
+subscription its own writable arrays, as rclpy does: that copy is the deserializer's policy,
+so two subscriptions of one process never share an array.)
 
 Hand-written because no library does this: ``multiprocessing.shared_memory`` gives a
 segment but no ring, no torn-read check, and its resource tracker unlinks segments other
@@ -233,9 +235,7 @@ class RingReader:
         self.overwritten = 0
         self.unmapped = 0
 
-    def read(
-        self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap
-    ) -> memoryview | None:
+    def read(self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap) -> memoryview | None:
         """The message a descriptor names (one copy, read-only), or None (counted) if gone."""
         if len(descriptor) != DESCRIPTOR.size:
             self.unmapped += 1
