@@ -221,7 +221,11 @@ class SharedMemory:
 
     def reader(self) -> RingReader:
         """A reader for one receiver (maps rings of this user and domain on first use)."""
-        return RingReader(self.path)
+        return RingReader(self.path, self._sweep_soon)
+
+    def _sweep_soon(self) -> None:
+        with self._lock:
+            self._maybe_sweep()
 
     def _maybe_sweep(self) -> None:
         now = time.monotonic()

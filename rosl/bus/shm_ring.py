@@ -228,8 +228,9 @@ class RingReader:
     copied: a slow subscriber) and ``unmapped`` (no such ring of this user, or not a ring).
     """
 
-    def __init__(self, name_of: Namer) -> None:
+    def __init__(self, name_of: Namer, on_map: Callable[[], None] | None = None) -> None:
         self._name_of = name_of
+        self._on_map = on_map  # told before each new ring is mapped (a cleanup pass)
         self._maps: OrderedDict[tuple[int, int, int, int], _Mapped] = OrderedDict()
         self._buffers = _Buffers()
         self.overwritten = 0
@@ -264,6 +265,8 @@ class RingReader:
         if ring is not None:
             self._maps.move_to_end(key)
             return ring
+        if self._on_map is not None:
+            self._on_map()
         path = self._name_of(*key)
         try:
             fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
