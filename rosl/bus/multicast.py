@@ -208,6 +208,8 @@ class MulticastTransport:
         """
         self.addressing = addressing
         self.auth = keys.load(addressing.domain) if auth == "env" else auth
+        # large messages between processes of this host (None: ROSL_SHM=0 or no /dev/shm)
+        self.shm = shared.SharedMemory(addressing.domain) if shared.enabled() else None
         self.name = "multicast"
         self.fix_hint = FIX_HINT
         self.domain = addressing.domain
@@ -219,8 +221,6 @@ class MulticastTransport:
         self._raw: dict[int, socket.socket] = {}
         self._lock = threading.Lock()
         self.send_errors = 0
-        # large messages between processes of this host (None: ROSL_SHM=0 or no /dev/shm)
-        self.shm = shared.SharedMemory(addressing.domain) if shared.enabled() else None
 
     def send(self, channel: int, parts: Sequence[Buffer]) -> None:
         """Send one datagram; a full kernel buffer drops it (counted), never blocks."""

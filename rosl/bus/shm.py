@@ -27,6 +27,7 @@ mapped it keep reading what they have (an unlinked file stays mapped).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import sys
@@ -35,6 +36,7 @@ import time
 import weakref
 from typing import TYPE_CHECKING
 
+from rosl.bus.errors import BusError
 from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner
 
 if TYPE_CHECKING:
@@ -51,23 +53,40 @@ SWEEP_S = 30.0
 STALE_PARTIAL_S = 60.0  # a file with no readable header this old is a half-made ring
 _NAME = re.compile(r"^rosl-u(\d+)-d(\d+)-p(\d+)-[0-9a-f]{16}-e\d+-r\d+$")
 _OFF = ("0", "off", "false", "no")
+_ON = ("", "1", "on", "true", "yes")
 
 
 def enabled(env: Mapping[str, str] | None = None) -> bool:
-    """Whether this process may use shared memory (``ROSL_SHM``, and a usable /dev/shm)."""
+    """Whether this process may use shared memory (``ROSL_SHM``, and a usable /dev/shm).
+
+    Raises:
+        BusError: ``ROSL_SHM`` is neither on (1, on, true, yes) nor off (0, off, false, no).
+    """
     environ = os.environ if env is None else env
-    if environ.get("ROSL_SHM", "").strip().lower() in _OFF:
+    value = environ.get("ROSL_SHM", "").strip().lower()
+    if value in _OFF:
         return False
+    if value not in _ON:
+        raise BusError(f"ROSL_SHM={value!r} is neither on (1, on, true, yes) nor off (0, off)")
     return os.path.isdir(DIRECTORY) and os.access(DIRECTORY, os.W_OK | os.X_OK)
 
 
 def threshold(env: Mapping[str, str] | None = None) -> int:
-    """Messages larger than this many bytes take the ring (``ROSL_SHM_THRESHOLD``)."""
+    """Messages larger than this many bytes take the ring (``ROSL_SHM_THRESHOLD``).
+
+    Raises:
+        BusError: ``ROSL_SHM_THRESHOLD`` is not a whole number of bytes from 1.
+    """
     text = (os.environ if env is None else env).get("ROSL_SHM_THRESHOLD", "").strip()
-    try:
-        return max(1, int(text)) if text else THRESHOLD
-    except ValueError:
+    if not text:
         return THRESHOLD
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise BusError(f"ROSL_SHM_THRESHOLD={text!r} is not a number of bytes (1 or more)")
+    return value
 
 
 def host_identity() -> str:
@@ -199,7 +218,7 @@ class SharedMemory:
             old.close()
         path = self.path(sender, endpoint, self._owner.pid, incarnation)
         try:
-            ring = RingWriter(path, self._owner, incarnation, slots, capacity)
+            ring = self._make(path, incarnation, slots, capacity)
         except OSError as err:
             self._failed = True
             self._rings.pop((sender, endpoint), None)
@@ -211,6 +230,16 @@ class SharedMemory:
             return None
         self._rings[(sender, endpoint)] = ring
         return ring
+
+    def _make(self, path: str, incarnation: int, slots: int, capacity: int) -> RingWriter:
+        """A new ring; with fewer slots (less slack) where /dev/shm is small (a container's)."""
+        while True:
+            try:
+                return RingWriter(path, self._owner, incarnation, slots, capacity)
+            except OSError as err:
+                if err.errno != errno.ENOSPC or slots <= MIN_SLOTS:
+                    raise
+                slots //= 2
 
     def drop(self, sender: int, endpoint: int) -> None:
         """An endpoint is gone: unlink its ring."""

@@ -11,6 +11,7 @@ import os
 import signal
 import stat
 import subprocess
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -213,3 +214,29 @@ def test_shared_memory_can_be_turned_off(processes: Processes, domain_id: int) -
         env={"ROSL_SHM": "off"},
     )
     assert Lines(child.stdout).wait_line("shm", 30.0) == "shm None"
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "words"),
+    [
+        ("ROSL_SHM", "maybe", "ROSL_SHM='maybe' is neither on"),
+        ("ROSL_SHM_THRESHOLD", "12k", "ROSL_SHM_THRESHOLD='12k' is not a number of bytes"),
+        ("ROSL_SHM_THRESHOLD", "0", "ROSL_SHM_THRESHOLD='0' is not a number of bytes"),
+    ],
+)
+def test_a_bad_shared_memory_setting_is_one_line_naming_it(
+    domain_id: int, name: str, value: str, words: str
+) -> None:
+    result = subprocess.run(
+        [sys.executable, "-m", "rosl", "topic", "list"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**os.environ, name: value},
+        check=False,
+    )
+    assert result.returncode == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(words)
