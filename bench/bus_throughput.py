@@ -115,8 +115,9 @@ def pub_bus(count: int, size: int, coalesce: bool = False, rate: float = 0.0) ->
         start, clock = time.perf_counter(), time.perf_counter
         for n in range(count):
             due = start + n / rate
-            if due - clock() > 0.001:  # long waits sleep (a spinning publisher starves the
-                time.sleep(due - clock() - 0.0005)  # subscriber of a 2-core machine)
+            ahead = due - clock()
+            if ahead > 0.001:  # long waits sleep (a spinning publisher starves the subscriber
+                time.sleep(ahead - 0.0005)  # of a 2-core machine), the rest spins
             while clock() < due:
                 pass
             writer.send(payload)
