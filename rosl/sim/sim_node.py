@@ -1,11 +1,13 @@
 """The sim node: a :class:`Simulation` on the bus, paced, free-running or in lock-step.
 
-It publishes ``/clock`` every physics step, and per robot odometry with ``odom ->
-base_footprint`` on ``/tf``, joint states (and the wheels on ``/tf``, as robot_state_publisher
-would), scans, and once (transient local) ``/tf_static``, ``robot_description`` and the
-world's geometry on ``/world_markers``; it drives each robot from its ``cmd_vel``. A topic
-nobody subscribes to is not computed nor sent (except ``/clock``): skipping it changes
-nothing else that is published.
+It publishes ``/clock`` at ``clock_rate`` Hz of sim time (10 by default, as gazebo_ros's
+``publish_rate``, which counts wall time; at or above the physics rate: every step) and on
+every step that publishes sensor data, so a subscriber's time is never behind a stamp it has
+received; per robot odometry with ``odom -> base_footprint`` on ``/tf``, joint states (and
+the wheels on ``/tf``, as robot_state_publisher would), scans, and once (transient local)
+``/tf_static``, ``robot_description`` and the world's geometry on ``/world_markers``; it
+drives each robot from its ``cmd_vel``. A topic nobody subscribes to is not computed nor
+sent (except ``/clock``): skipping it changes nothing else that is published.
 
 Modes: paced at ``real_time_factor`` x wall time (default 1); ``fast``: lock-step (see
 :mod:`rosl.node.lockstep`) - each step's messages are handled by the controllers before the
@@ -23,7 +25,6 @@ keep one datagram per message and serve the bus every step.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from dataclasses import dataclass
@@ -32,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.sim import messages as build
 from rosl.sim.report import RobotReport, SimReport
+from rosl.sim.simulation import Schedule
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -113,7 +115,14 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
-        self._next_event = 0.0  # sim ns of the next sensor or odometry firing
+        self._next_event = 0.0  # sim ns of the next firing of a sensor, odometry or /clock
+        self._clock_schedule = Schedule(options.clock_rate)
+        self._schedules = [self._clock_schedule] + [
+            schedule
+            for r in sim.robots
+            for schedule in (r.odom, r.joints, *(s for _, s in r.lidars))
+            if schedule is not None
+        ]
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._batched = not options.fast and options.record is None
@@ -225,9 +234,10 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
-        if now < self._next_event:  # most steps: only the time moves on
-            self._send_clock(build.clock_bytes(now))
+        if now < self._next_event:  # most steps: nothing is due, not even /clock
             return
+        if self._clock_schedule.due(now):
+            self._clock_schedule.fire(now)
         sampled = False
         transforms: list[build.Transform] = []
         for topics in self.robots:
@@ -256,16 +266,8 @@ class SimNode:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))
-        self.clock.send(build.clock_bytes(now))
-        self._next_event = min(
-            [r.odom.at_ns for r in sim.robots]
-            + [r.joints.at_ns for r in sim.robots if r.joints is not None]
-            + [schedule.at_ns for r in sim.robots for _, schedule in r.lidars],
-            default=math.inf,
-        )
-
-    def _send_clock(self, data: bytes) -> None:
-        self.clock.send(data)
+        self.clock.send(build.clock_bytes(now))  # with every step's data, and at clock_rate
+        self._next_event = min([schedule.at_ns for schedule in self._schedules])
 
     # --- running -----------------------------------------------------------------------------
 
@@ -289,7 +291,6 @@ class SimNode:
         else:
             for topic in self._stepped():
                 topic.free()
-            self._send_clock = self.clock.send  # type: ignore[method-assign,assignment]
         if self._batched:
             for topic in self._stepped():
                 topic.publisher.hold_until_flush()
