@@ -305,6 +305,29 @@ class Writer:
             self.last_seq = number
         return number
 
+    def send_all(self, payloads: list[bytes]) -> None:
+        """Send plain messages in order, stamped now: a batching writer adds them in one loop.
+
+        The same as :meth:`send` for each (numbers, counts, batches), without its options'
+        per-message cost; a message too big for a batch, or a writer that does not batch,
+        goes through :meth:`send`.
+        """
+        batch = self.batch
+        if batch is None or self.flags:
+            for payload in payloads:
+                self.send(payload)
+            return
+        stamp = time.time_ns()
+        add, fits, numbers = batch.add, batch.fits, self._seq
+        for payload in payloads:
+            if fits(len(payload)):
+                number = next(numbers) & 0xFFFFFFFF
+                add(number, stamp, payload)
+                self.sent += 1
+                self.last_seq = number
+            else:
+                self.send(payload)
+
 
 class Reader:
     """Turns a receiver's datagrams into complete :class:`Delivery` records."""

@@ -58,6 +58,7 @@ class _Topic:
         self.publisher = publisher
         self.always = always
         self._publish = publisher.publish
+        self._pending: list[bytes] = []
 
     def wanted(self) -> bool:
         return self.always or self.sim_node.subscribed(self.publisher.topic)
@@ -71,6 +72,19 @@ class _Topic:
     def free(self) -> None:
         """No lock-step: sending is publishing, one call less per message."""
         self.send = self._publish  # type: ignore[method-assign,assignment]
+
+    def queue(self) -> None:
+        """Batched: messages wait in a list until :meth:`flush` publishes them all at once."""
+        self.publisher.hold_until_flush()
+        self.send = self._pending.append  # type: ignore[method-assign,assignment]
+
+    def flush(self) -> None:
+        """Publish what waits, and send the publisher's batch."""
+        pending = self._pending
+        if pending:
+            self.publisher.publish_all(pending)
+            pending.clear()
+        self.publisher.flush()
 
 
 @dataclass(slots=True)
@@ -126,6 +140,7 @@ class SimNode:
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._batched = not options.fast and options.record is None
+        self._flushed: list[_Topic] = []  # batched: the sensors' topics first, /clock last
         self.clock = _Topic(
             self,
             node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
@@ -293,7 +308,8 @@ class SimNode:
                 topic.free()
         if self._batched:
             for topic in self._stepped():
-                topic.publisher.hold_until_flush()
+                topic.queue()
+            self._flushed = list(reversed(self._stepped()))
         self.publish_static()
         self._announce()
         self._wait_for_peers()
@@ -355,8 +371,8 @@ class SimNode:
     def _flush(self) -> None:
         """Paced: send what the batches hold, the sensors' first and ``/clock`` last."""
         if self._batched:
-            for topic in reversed(self._stepped()):
-                topic.publisher.flush()
+            for topic in self._flushed:
+                topic.flush()
 
     def _stepped(self) -> list[_Topic]:
         """The topics published as the simulation steps."""
