@@ -251,33 +251,37 @@ class SimNode:
         now = sim.now_ns
         if now < self._next_event:  # most steps: nothing is due, not even /clock
             return
-        if self._clock_schedule.due(now):
-            self._clock_schedule.fire(now)
+        clock = self._clock_schedule
+        if now >= clock.at_ns:
+            clock.fire(now)
         sampled = False
         transforms: list[build.Transform] = []
         for topics in self.robots:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
-            if sim_robot.odom.due(now):
-                sim_robot.odom.fire(now)
+            odom = sim_robot.odom
+            if now >= odom.at_ns:
+                odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
-                odom = sim_robot.robot.odometry()
+                state = sim_robot.robot.odometry()
                 if topics.odom.wanted():
-                    topics.odom.send(encoder.odometry(now, odom))
-                transforms.append(encoder.odom_transform(odom))
-            if sim_robot.joints is not None and sim_robot.joints.due(now):
-                sim_robot.joints.fire(now)
+                    topics.odom.send(encoder.odometry(now, state))
+                transforms.append(encoder.odom_transform(state))
+            joints = sim_robot.joints
+            if joints is not None and now >= joints.at_ns:
+                joints.fire(now)
                 if topics.joints is not None and topics.joints.wanted():
                     topics.joints.send(encoder.joint_states(now))
                 transforms += encoder.wheel_transforms()
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
-                if schedule.due(now):
+                if now >= schedule.at_ns:
                     index = schedule.fire(now)
-                    if topic.wanted() or self.options.render is not None:
+                    wanted = topic.wanted()
+                    if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
-                        if topic.wanted():
+                        if wanted:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))

@@ -52,8 +52,12 @@ class Schedule:
     def fire(self, now_ns: int) -> int:
         """Take the due firing; return its k. Firings missed in one step are skipped."""
         index = self.index
-        self.index = max(index + 1, math.floor(now_ns * self.rate / NS) + 1)
-        self.at_ns = self._at(self.index)
+        after = index + 1
+        at_ns = round(after * NS / self.rate)  # due, so the rate is positive
+        if now_ns >= at_ns:  # that one is due too: skip to the first after now
+            after = max(after, math.floor(now_ns * self.rate / NS) + 1)
+            at_ns = round(after * NS / self.rate)
+        self.index, self.at_ns = after, at_ns
         return index
 
 
