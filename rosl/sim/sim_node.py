@@ -16,11 +16,11 @@ messages go out before ``/clock``, so a timer woken by the new time sees the ste
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
 
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
-small messages join their topic's batch, which this thread sends once a millisecond of wall
-time and before it sleeps (sensors first, ``/clock`` last; no timer thread contends for the
-GIL), and the bus is served at that pace rather than every step: a datagram per step per topic
-would cost more than the physics. Lock-step and recording
-keep one datagram per message and serve the bus every step.
+messages wait in their topic's list, which this thread publishes as one batch once a
+millisecond of wall time and before it sleeps (sensors first, ``/clock`` last; no timer thread
+contends for the GIL), and the bus is served at that pace rather than every step: a datagram,
+or even a publish call, per step per topic would cost more than the physics. Lock-step and
+recording keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
