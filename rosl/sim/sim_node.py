@@ -25,6 +25,7 @@ recording keep one datagram per message and serve the bus every step.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass
@@ -56,7 +57,7 @@ class _Topic:
     def __init__(self, sim_node: SimNode, publisher: Publisher, always: bool = False) -> None:
         self.sim_node = sim_node
         self.publisher = publisher
-        self.always = always
+        self.always = always or sim_node._publish_all
         self._publish = publisher.publish
         self._pending: list[bytes] = []
 
@@ -352,6 +353,7 @@ class SimNode:
         sim, tick, step = self.sim, self.tick, self.sim.step
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
+        end = math.inf if end_ns is None else end_ns
         status_at = started + 1.0
         serve_at = 0.0
         while True:
@@ -365,12 +367,14 @@ class SimNode:
                 if live and wall >= status_at:
                     status_at += 1.0
                     self._status(started)
-            if end_ns is not None and sim.now_ns >= end_ns:
+            now = sim.now_ns
+            if now >= end:
                 return
-            if started + (sim.now_ns + sim.step_ns) / scale > wall:
+            if started + (now + sim.step_ns) / scale > wall:
                 self._pace(started)
             step()
-            tick()
+            if sim.now_ns >= self._next_event:  # most steps publish nothing: no call
+                tick()
 
     def _flush(self) -> None:
         """Paced: send what the batches hold, the sensors' first and ``/clock`` last."""
