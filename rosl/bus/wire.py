@@ -317,16 +317,16 @@ class Writer:
             for payload in payloads:
                 self.send(payload)
             return
-        stamp = time.time_ns()
-        add, fits, numbers = batch.add, batch.fits, self._seq
-        for payload in payloads:
-            if fits(len(payload)):
-                number = next(numbers) & 0xFFFFFFFF
-                add(number, stamp, payload)
-                self.sent += 1
-                self.last_seq = number
-            else:
+        if not batch.fits(max(map(len, payloads), default=0)):  # a big one keeps its place
+            for payload in payloads:
                 self.send(payload)
+            return
+        first = next(self._seq)
+        count = len(payloads)
+        self._seq = itertools.count(first + count)
+        batch.add_all(first, time.time_ns(), payloads)
+        self.sent += count
+        self.last_seq = (first + count - 1) & 0xFFFFFFFF
 
 
 class Reader:
