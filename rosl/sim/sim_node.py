@@ -80,12 +80,12 @@ class _Topic:
         self.send = self._pending.append  # type: ignore[method-assign,assignment]
 
     def flush(self) -> None:
-        """Publish what waits, and send the publisher's batch."""
+        """Publish what waits as the publisher's batch, and send it (its only messages)."""
         pending = self._pending
         if pending:
             self.publisher.publish_all(pending)
             pending.clear()
-        self.publisher.flush()
+            self.publisher.flush()
 
 
 @dataclass(slots=True)
