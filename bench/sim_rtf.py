@@ -8,11 +8,14 @@ Rows (median of 3):
   node-720    the same with a 10 Hz x 720-ray LiDAR
   lock-step   `rosl sim --fast` with the obstacle-avoidance node in another process answering
               every scan over the bus (the demo's set-up, recording off)
-Each row prints its real-time factor (sim seconds per wall second) and its ratio to the core
-measured in this run. Targets (issue 7): node >= 200x, node-720 >= 100x, lock-step >= 30x;
-Gazebo runs these worlds at 1x, ir-sim ~2x with a per-step LiDAR. Issue 17: node >= 0.7 x
-core, and the core >= 2 x the previous implementation's on the same machine: ``--previous``
-names a checkout of it (a git worktree), whose core runs in a child process in this run.
+Each row prints its real-time factor and its ratio to the core measured in this run. The core
+and node rows count this process's CPU seconds (the machine may be shared: wall time would
+count other processes' turns on the CPU); lock-step, two processes, counts wall seconds.
+Targets (issue 7): node >= 200x, node-720 >= 100x, lock-step >= 30x; Gazebo runs these
+worlds at 1x, ir-sim ~2x with a per-step LiDAR. Issue 17: node >= 0.7 x core, and the core
+>= 2 x the previous implementation's on the same machine: ``--previous`` names a checkout of
+it (a git worktree, or ``git archive`` of the commit unpacked), whose core runs in a child
+process in this run.
 """
 
 from __future__ import annotations
@@ -55,7 +58,7 @@ def core(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
     robot = sim.robots[0]
     robot.robot.command(0.1, 0.2)
     end = round(seconds * NS)
-    started = time.perf_counter()
+    started = time.process_time()
     while sim.now_ns < end:
         sim.step()
         if robot.odom.due(sim.now_ns):
@@ -64,7 +67,7 @@ def core(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
         for lidar, schedule in robot.lidars:
             if schedule.due(sim.now_ns):
                 sim.scan(robot, lidar, schedule.fire(sim.now_ns))
-    return seconds / (time.perf_counter() - started)
+    return seconds / (time.process_time() - started)
 
 
 def node(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
@@ -78,8 +81,9 @@ def node(seconds: float, rays: int = 360, rate: float = 5.0) -> float:
     try:
         options = SimOptions(real_time_factor=1e9, duration=seconds, headless=True)
         runner = SimNode(Simulation(world(rays, rate)), sim_node, options, publish_all=True)
+        started = time.process_time()
         report = runner.run()
-        return report.sim_seconds / report.wall_seconds
+        return report.sim_seconds / (time.process_time() - started)
     finally:
         sim_node.destroy_node()
         rosl.try_shutdown()

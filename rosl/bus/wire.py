@@ -342,6 +342,29 @@ class Writer:
             self.last_seq = number
         return number
 
+    def send_all(self, payloads: list[bytes]) -> None:
+        """Send plain messages in order, stamped now: a batching writer adds them in one loop.
+
+        The same as :meth:`send` for each (numbers, counts, batches), without its options'
+        per-message cost; a message too big for a batch, or a writer that does not batch,
+        goes through :meth:`send`.
+        """
+        batch = self.batch
+        if batch is None or self.flags:
+            for payload in payloads:
+                self.send(payload)
+            return
+        if not batch.fits(max(map(len, payloads), default=0)):  # a big one keeps its place
+            for payload in payloads:
+                self.send(payload)
+            return
+        first = next(self._seq)
+        count = len(payloads)
+        self._seq = itertools.count(first + count)
+        batch.add_all(first, time.time_ns(), payloads)
+        self.sent += count
+        self.last_seq = (first + count - 1) & 0xFFFFFFFF
+
 
 class Reader:
     """Turns a receiver's datagrams into complete :class:`Delivery` records."""

@@ -10,6 +10,7 @@ import click
 from rosl.cli import render
 from rosl.cli.companion import companion_options
 from rosl.cli.options import domain_option
+from rosl.sim.options import CLOCK_RATE
 
 
 @click.command("sim")
@@ -72,6 +73,14 @@ from rosl.cli.options import domain_option
     show_default=True,
     help="Lock-step: what to do when a controller stops answering",
 )
+@click.option(
+    "--clock-rate",
+    type=float,
+    default=CLOCK_RATE,
+    show_default=True,
+    metavar="HZ",
+    help="Publish /clock this often in sim time, and with every step's sensor data",
+)
 @companion_options
 @domain_option
 def command(world: str, **options: Any) -> None:
@@ -99,6 +108,7 @@ def _simulate(world: str, options: dict[str, Any]) -> None:
         render=options["picture"], headless=options["headless"],
         wait_for=list(options["wait_for"]), startup_timeout=options["startup_timeout"],
         lockstep_timeout=options["lockstep_timeout"], on_stall=options["on_stall"],
+        clock_rate=options["clock_rate"],
     )  # fmt: skip
     report = simulate(world, sim_options, seed=options["seed"], domain=options["domain_id"])
     render.lines(report.lines())

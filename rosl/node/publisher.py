@@ -95,6 +95,21 @@ class Publisher:
         if self._history is not None:
             self._history.append((seq, now, data))
 
+    def publish_all(self, payloads: list[bytes]) -> None:
+        """Send already-serialized messages in order, as :meth:`publish` each would.
+
+        For a caller that queues its own messages between flushes: a batching publisher adds
+        them in one loop rather than one call each.
+        """
+        if not payloads:
+            return
+        if self._history is not None or self._manual:  # each needs its own record
+            for payload in payloads:
+                self.publish(payload)
+            return
+        self._writer.send_all(payloads)
+        self.last_published_ns = time.time_ns()
+
     def replay(self, target: tuple[int, int]) -> None:
         """Send the kept history to one late subscriber (transient local)."""
         if self._history is None or self.destroyed:

@@ -18,7 +18,7 @@ from functools import cache
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Callable, Sequence
 
     import numpy as np
 
@@ -67,16 +67,35 @@ def clock(now_ns: int) -> bytes:
     return _CLOCK.pack(HEADER, sec, nanosec)
 
 
+_TWIST = struct.Struct("<6d")
+
+
 @cache
-def _odometry_layout(frame: bytes, child: bytes) -> struct.Struct:
+def odometry_packer(
+    frame: bytes, child: bytes, covariance: tuple[float, ...]
+) -> Callable[[int, Sequence[float], Sequence[float]], bytes]:
+    """A function packing nav_msgs/msg/Odometry of (now_ns, pose, twist) for fixed frames.
+
+    The header and the pose are one ``pack``; the covariance (the same for the pose and the
+    twist) is packed here once; the doubles are contiguous, so the parts only join.
+    """
     layout = _Layout()
     layout.format += "4s"  # the encapsulation header (not counted in offsets)
     layout.field("i", 4)
     layout.field("I", 4)
     layout.string(frame)
     layout.string(child)
-    layout.field("d", 8, 85)
-    return layout.struct()
+    layout.field("d", 8, 7)  # the pose: 8-aligned and 56 bytes, so the rest needs no padding
+    pack_head, pack_twist = layout.struct().pack, _TWIST.pack
+    packed_covariance = struct.pack("<36d", *covariance)
+    frame_size, child_size = len(frame) + 1, len(child) + 1
+
+    def pack(now_ns: int, pose: Sequence[float], twist: Sequence[float]) -> bytes:
+        sec, nanosec = divmod(now_ns, NS)
+        head = pack_head(HEADER, sec, nanosec, frame_size, frame, child_size, child, *pose)
+        return b"".join((head, packed_covariance, pack_twist(*twist), packed_covariance))
+
+    return pack
 
 
 def odometry(now_ns: int, frame: bytes, child: bytes, pose: Sequence[float],
@@ -86,11 +105,7 @@ def odometry(now_ns: int, frame: bytes, child: bytes, pose: Sequence[float],
     ``pose`` is x, y, z, qx, qy, qz, qw; ``twist`` 6 values; the same 36 ``covariance``
     values go with the pose and the twist.
     """
-    sec, nanosec = _split_secs(now_ns)
-    return _odometry_layout(frame, child).pack(
-        HEADER, sec, nanosec, len(frame) + 1, frame, len(child) + 1, child,
-        *pose, *covariance, *twist, *covariance,
-    )  # fmt: skip
+    return odometry_packer(frame, child, tuple(covariance))(now_ns, pose, twist)
 
 
 @cache

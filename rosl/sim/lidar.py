@@ -1,16 +1,17 @@
 """2D LiDAR: rays cast with numpy against segments and circles, Gazebo's scan conventions.
 
 Hand-written because no library casts a fan of rays against a few hundred edges fast enough
-(pymunk's per-ray ``segment_query_first`` costs ~3 us a ray, ~1 ms a 360-ray scan). Each edge
-and circle is tested only against the rays inside the angle it spans as seen from the sensor
-(edges facing away are dropped first), so the work grows with what the rays can hit, not with
-rays x edges; all of them go through one batch of numpy calls. Results agree with pymunk's
-own queries to ~1e-12 m (a test checks).
+(pymunk's per-ray ``segment_query_first`` costs ~3 us a ray, ~1 ms a 360-ray scan). The
+world's edges come prepared (:class:`~rosl.sim.world.Geometry`: one-sided, with their
+normals); each edge facing the sensor and each circle is tried only with the rays inside the
+angle it spans as seen from the sensor, so the work grows with what the rays can hit, not
+with rays x edges; all of them go through one batch of numpy calls. Hits and misses agree
+with pymunk's own queries, distances to ~1e-12 m (a test checks).
 
 Gazebo's conventions: ``angle_increment = (max - min) / (samples - 1)``; no return is +inf, a
 return closer than range_min is -inf (REP 117). Noise comes from a generator seeded by the
-world's seed, the sensor's name and the scan's index, so a scan is the same whether or not
-earlier scans were computed.
+world's seed, the sensor's name and the scan's index (its block of :data:`NOISE_BLOCK`
+scans), so a scan is the same whether or not earlier scans were computed.
 """
 
 from __future__ import annotations
@@ -22,11 +23,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from rosl.sim.world import Geometry
+
 if TYPE_CHECKING:
-    from rosl.sim.world import Geometry
     from rosl.sim.worldfile import Lidar
 
 TWO_PI = 2.0 * math.pi
+NOISE_BLOCK = 50  # scans whose noise is drawn at once (10 s of a 5 Hz LiDAR)
 _SHIFTS = np.array([-TWO_PI, 0.0, TWO_PI])
 
 
@@ -51,42 +54,18 @@ def _owners(count: int) -> np.ndarray:
     return values
 
 
-def _ray_windows(
-    lo: np.ndarray, span: np.ndarray, inc: float, n: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Ray indices whose angle (relative to ray 0, mod 2 pi) lies in [lo, lo + span].
-
-    A window is widened by a ray at each end (rounding): a candidate ray that misses is only
-    tested, never counted, so wider is safe. Pairs come out in item order.
-
-    Returns:
-        (item, ray): for each candidate pair, the index of the edge/circle and of the ray.
-    """
-    if inc <= 0.0:  # one ray: a candidate for everything
-        items = np.arange(len(lo))
-        return items, np.zeros(len(lo), dtype=np.intp)
-    scale = 1.0 / inc
-    base = (lo[:, None] - _SHIFTS) * scale
-    # truncation is at most one above floor (negative values): the -1 / +1 pads cover it
-    start = np.maximum(base.astype(np.intp) - 1, 0).ravel()
-    end = np.minimum((base + (span * scale)[:, None]).astype(np.intp) + 1, n - 1).ravel()
-    counts = np.maximum(end - start + 1, 0)
-    total = int(counts.sum())
-    if total == 0:
-        return np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
-    item = np.repeat(_owners(len(lo)), counts)
-    ray = np.arange(total) - np.repeat(np.cumsum(counts) - counts - start, counts)
-    return item, ray
-
-
 def cast(
     x: float, y: float, first: float, inc: float, n: int, reach: float, geometries: list[Geometry]
 ) -> np.ndarray:
     """Distances along ``n`` rays from (x, y) to the first obstacle; +inf if none within reach.
 
-    The edges and circles of every geometry go through one batch: their angular windows, the
-    ray directions and the closest hits are each computed once for all of them (a scan costs
-    a fixed few dozen numpy calls, whatever the world holds).
+    Every edge facing the sensor and every circle within reach spans a window of rays, the
+    rays whose angle lies between the angles of its ends (or of its tangents): ``ceil`` and
+    ``floor`` of those angles in ray units. Each (item, ray) pair then costs one closed
+    formula, ``t = d / cos(theta - psi)`` for an edge at distance ``d`` along its normal at
+    angle ``psi``, ``t = b -+ sqrt(b^2 - (D^2 - r^2))`` with ``b = D cos(theta - beta)`` for a
+    circle at distance ``D`` and angle ``beta``, and the closest per ray wins. All edges and
+    circles go through one batch: a scan is a fixed few dozen numpy calls.
 
     Args:
         x: sensor position in the world.
@@ -98,59 +77,58 @@ def cast(
         geometries: obstacles (static, moving, other robots).
     """
     best = np.full(n, np.inf)
-    near = [geometry.near(x, y, reach, facing=True) for geometry in geometries]
-    segments = near[0][0] if len(near) == 1 else np.concatenate([s for s, _ in near])
-    circles = near[0][1] if len(near) == 1 else np.concatenate([c for _, c in near])
-    count = len(segments)
-    if not count and not len(circles):
+    geometry = Geometry.joined(geometries)
+    edges, circles = geometry.edges, geometry.circles
+    if inc <= 0.0:  # one ray: any positive unit places it at 0
+        inc = 1.0
+    scale = 1.0 / inc
+    # the edges facing the sensor, no farther than reach from it along their normal
+    depth = edges[:, 6] - (edges[:, 4] * x + edges[:, 5] * y)  # n.a - n.s: < 0 when facing
+    facing = ((depth < 0.0) & (depth > -reach)).nonzero()[0]
+    chosen = edges[facing]
+    depth = depth[facing]
+    # the circles that reach within range
+    ox, oy = circles[:, 0] - x, circles[:, 1] - y
+    distance = np.hypot(ox, oy)
+    near = (distance - circles[:, 2] <= reach).nonzero()[0]
+    count, round_count = len(facing), len(near)
+    if not count and not round_count:
         return best
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ax, ay = segments[:, 0] - x, segments[:, 1] - y
-        bx, by = segments[:, 2] - x, segments[:, 3] - y
-        angle_a = np.arctan2(ay, ax)
-        angle_b = np.arctan2(by, bx)
-        ccw = ax * by - ay * bx >= 0.0  # a -> b turns counter-clockwise around the sensor
-        seg_lo = np.where(ccw, angle_a, angle_b)
-        seg_span = np.mod(np.where(ccw, angle_b, angle_a) - seg_lo, TWO_PI)
-        ox, oy = circles[:, 0] - x, circles[:, 1] - y
-        radius = circles[:, 2]
-        distance = np.hypot(ox, oy)
-        half = np.where(
-            distance <= radius,  # inside: every ray
-            math.pi,
-            np.arcsin(np.minimum(radius / np.maximum(distance, 1e-12), 1.0)),  # both >= 0
+    distance, radius = distance[near], circles[near, 2]
+    inside = distance <= radius
+    ratio = np.minimum(radius / np.maximum(distance, 1e-300), 1.0)
+    half = np.where(inside, math.pi, np.arcsin(ratio))  # the tangents' angle from the centre
+    # in ray units from ray 0: a facing edge runs clockwise seen from the sensor (b to a)
+    units = (
+        np.arctan2(
+            np.concatenate((chosen[:, 3], chosen[:, 1], circles[near, 1])) - y,
+            np.concatenate((chosen[:, 2], chosen[:, 0], circles[near, 0])) - x,
         )
-        lo = np.mod(np.concatenate((seg_lo, np.arctan2(oy, ox) - half)) - first, TWO_PI)
-        item, ray = _ray_windows(lo, np.concatenate((seg_span, 2.0 * half)), inc, n)
-        if not len(ray):
-            return best
-        theta = first + inc * ray
-        dx, dy = np.cos(theta), np.sin(theta)
-        split = int(np.searchsorted(item, count))  # the pairs come in item order: edges first
-        hits = []
-        if split:
-            edge = item[:split]
-            sdx, sdy = dx[:split], dy[:split]
-            sax, say = ax[edge], ay[edge]
-            ex, ey = bx[edge] - sax, by[edge] - say
-            denom = sdx * ey - sdy * ex
-            t = (sax * ey - say * ex) / denom
-            u = (sax * sdy - say * sdx) / denom
-            hit = (t >= 0.0) & (u >= 0.0) & (u <= 1.0) & (denom != 0.0)
-            hits.append((ray[:split][hit], t[hit]))
-        if split < len(item):
-            circle = item[split:] - count
-            cdx, cdy = dx[split:], dy[split:]
-            cx, cy, r = ox[circle], oy[circle], radius[circle]
-            b = cdx * cx + cdy * cy  # distance along the ray to the closest point
-            disc = b * b - (cx * cx + cy * cy - r * r)
-            root = np.sqrt(disc)
-            near_t = b - root
-            t = np.where(near_t >= 0.0, near_t, b + root)
-            hit = (disc >= 0.0) & (t >= 0.0)
-            hits.append((ray[split:][hit], t[hit]))
-    for rays, ts in hits:
-        np.minimum.at(best, rays, ts)
+        - first
+    ) % TWO_PI
+    beta = units[2 * count :]  # the circles' centres (radians from ray 0)
+    lo = np.concatenate((units[:count], beta - half)) % TWO_PI * scale
+    span = np.concatenate(((units[count : 2 * count] - units[:count]) % TWO_PI, 2.0 * half))
+    lo = (lo[:, None] + _SHIFTS * scale).ravel()  # item by item, its three shifted windows
+    span = np.repeat(span * scale, len(_SHIFTS))
+    start = np.maximum(np.ceil(lo), 0.0)
+    counts = np.maximum(np.minimum(np.floor(lo + span), n - 1.0) - start + 1.0, 0.0).astype(np.intp)
+    ends = np.cumsum(counts)
+    total = int(ends[-1])
+    if not total:
+        return best
+    item = np.repeat(_owners(count + round_count), counts)
+    ray = np.arange(total) - np.repeat(ends - counts - start.astype(np.intp), counts)
+    split = int(ends[3 * count - 1]) if count else 0  # the edges' pairs come first
+    theta = ray * inc  # ray angles from ray 0
+    edge = item[:split]
+    psi = geometry.normal_angles[facing] - first
+    t_edge = depth[edge] / np.cos(theta[:split] - psi[edge])
+    circle = item[split:] - count
+    b = distance[circle] * np.cos(theta[split:] - beta[circle])
+    root = np.sqrt(np.maximum(b * b - (distance * distance - radius * radius)[circle], 0.0))
+    t_circle = b + np.where(inside, 1.0, -1.0)[circle] * root  # the far side from inside
+    np.minimum.at(best, ray, np.concatenate((t_edge, t_circle)))
     best[best > reach] = np.inf
     return best
 
@@ -177,11 +155,23 @@ def scan(
         geometries,
     )
     if lidar.noise_stddev > 0.0:  # no return stays +inf: inf + noise is inf
-        rng = np.random.default_rng([seed & 0xFFFFFFFF, _crc(lidar.name), index])
-        ranges += rng.normal(0.0, lidar.noise_stddev, len(ranges))
+        block = _noise_block(seed & 0xFFFFFFFF, _crc(lidar.name), index // NOISE_BLOCK, len(ranges))
+        ranges += block[index % NOISE_BLOCK] * lidar.noise_stddev
     ranges[ranges < lidar.range_min] = -np.inf
     ranges[ranges > lidar.range_max] = np.inf
     return ranges.astype(np.float32)
+
+
+@functools.lru_cache(maxsize=16)
+def _noise_block(seed: int, name: int, block: int, samples: int) -> np.ndarray:
+    """Standard normal noise of scans ``block * NOISE_BLOCK`` on, one row a scan.
+
+    One generator per block of scans: seeding a generator costs more than drawing a scan's
+    noise, and a block depends only on the seed, the sensor and its number.
+    """
+    values = np.random.default_rng([seed, name, block]).standard_normal((NOISE_BLOCK, samples))
+    values.setflags(write=False)
+    return values
 
 
 @functools.lru_cache(maxsize=64)

@@ -308,6 +308,7 @@ class RobotEncoder:
         model = sim_robot.robot.spec.model
         self.odom_frame = model.odom_frame.encode()
         self.base_frame = model.base_frame.encode()
+        self._pack_odometry = encode.odometry_packer(self.odom_frame, self.base_frame, _COVARIANCE)
         self.joint_names = [j.encode() for j in model.joints]
         index = {joint: k for k, joint in enumerate(model.joints)}
         self.wheels = [
@@ -328,16 +329,20 @@ class RobotEncoder:
     ) -> bytes:
         """nav_msgs/Odometry of ``odom`` (the robot's :meth:`odometry`) as CDR."""
         (x, y, yaw), (forward, turn) = odom
-        return encode.odometry(
-            now_ns, self.odom_frame, self.base_frame,
-            (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)), _COVARIANCE,
+        return self._pack_odometry(
+            now_ns,
+            (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
             (forward, 0.0, 0.0, 0.0, 0.0, turn),
-        )  # fmt: skip
+        )
 
     def odom_transform(self, odom: tuple[tuple[float, float, float], object]) -> Transform:
         """``odom -> base_footprint`` of ``odom`` (the robot's :meth:`odometry`)."""
         x, y, yaw = odom[0]
-        return (self.odom_frame, self.base_frame, (x, y, 0.0, *quaternion(0.0, 0.0, yaw)))
+        half = yaw / 2  # quaternion(0, 0, yaw)
+        return (
+            self.odom_frame, self.base_frame,
+            (x, y, 0.0, 0.0, 0.0, math.sin(half), math.cos(half)),
+        )  # fmt: skip
 
     def wheel_transforms(self) -> list[Transform]:
         """The wheel links turned by their joints."""

@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+CLOCK_RATE = 10.0  # Hz of sim time: gazebo_ros's /clock publish_rate default (it counts wall time)
+
 
 @dataclass(slots=True)
 class SimOptions:
@@ -20,6 +22,7 @@ class SimOptions:
     startup_timeout: float = 10.0
     lockstep_timeout: float = 5.0
     on_stall: str = "continue"
+    clock_rate: float = CLOCK_RATE
 
 
 def parse_arguments(argv: list[str]) -> tuple[Path, SimOptions, int | None]:
@@ -39,6 +42,7 @@ def parse_arguments(argv: list[str]) -> tuple[Path, SimOptions, int | None]:
     parser.add_argument("--startup-timeout", type=float, default=10.0)
     parser.add_argument("--lockstep-timeout", type=float, default=5.0)
     parser.add_argument("--on-stall", choices=["continue", "stop"], default="continue")
+    parser.add_argument("--clock-rate", type=float, default=CLOCK_RATE)
     args = parser.parse_args(argv)
     options = SimOptions(
         real_time_factor=args.real_time_factor,
@@ -51,5 +55,6 @@ def parse_arguments(argv: list[str]) -> tuple[Path, SimOptions, int | None]:
         startup_timeout=args.startup_timeout,
         lockstep_timeout=args.lockstep_timeout,
         on_stall=args.on_stall,
+        clock_rate=args.clock_rate,
     )
     return Path(args.world), options, args.seed

@@ -1,17 +1,18 @@
-"""A differential-drive robot: commanded through pymunk's velocity function, never tunnelling.
+"""A differential-drive robot: commanded through a one-step force, never tunnelling.
 
-The command is clamped to the model's limits and ramped at its acceleration limit; each
-physics step sets the body's velocity from inside ``velocity_func``, so pymunk's contact
-solver still stops the robot at walls (writing velocities before ``step()`` would tunnel).
-A groove joint along the heading, moved before every step while the robot touches something,
-is the wheels' grip: the solver cannot slide the robot sideways, so pushing on against an
-obstacle stalls it where it hit, as on Gazebo or a real floor (driving free, the velocity
-function alone keeps it on its heading, and the joint costs nothing). Odometry is the body's
-motion relative to its spawn pose, in the ``odom`` frame.
+The command is clamped to the model's limits and ramped at its acceleration limit; before
+each physics step the body gets the force that brings its velocity to the ramped one in that
+step, so pymunk's contact solver, which runs after, still stops the robot at walls (writing
+velocities before ``step()`` would tunnel, and a ``velocity_func`` costs a Python callback
+from inside every step). A groove joint along the heading, moved before every step while
+the robot touches something, is the wheels' grip: the solver cannot slide the robot
+sideways, so pushing on against an obstacle stalls it where it hit, as on Gazebo or a real
+floor (driving free, the force alone keeps it on its heading, and the joint costs nothing).
+Odometry is the body's motion relative to its spawn pose, in the ``odom`` frame.
 
 The per-step reads and writes of the body go straight to chipmunk's C functions (pymunk's
 ``lib``, the same calls its properties make): the properties' Python layers cost more than
-the physics step itself.
+the physics step itself. The body is read once after each step and kept (pose, velocities).
 """
 
 from __future__ import annotations
@@ -30,7 +31,9 @@ if TYPE_CHECKING:
 
 ABSURD = 1e3  # m/s or rad/s: a command beyond this is a bug upstream, not a wish
 GROOVE = 1e3  # metres: half the length of the line the robot may move along in one step
-_LIB: Any = importlib.import_module("pymunk._chipmunk").lib  # what pymunk.Body's properties call
+_CHIPMUNK: Any = importlib.import_module("pymunk._chipmunk")
+_LIB: Any = _CHIPMUNK.lib  # what pymunk.Body's properties call
+_FFI: Any = _CHIPMUNK.ffi
 
 
 class DiffDriveRobot:
@@ -55,7 +58,6 @@ class DiffDriveRobot:
         self._space = space
         self.contacts = 0  # obstacles touching the robot now (the simulation counts them)
         self._gripping = False
-        self.body.velocity_func = self._velocity
         self.target = (0.0, 0.0)
         self.v = 0.0
         self.w = 0.0
@@ -67,6 +69,13 @@ class DiffDriveRobot:
         self._half = model.wheel_separation / 2
         self._radius = model.wheel_radius
         self._c_body = self.body._body  # chipmunk's cpBody*
+        # the body as the last step left it (nothing else moves it between steps)
+        self._x, self._y = self.body.position
+        self._angle = self.body.angle
+        self._velocity = (0.0, 0.0)
+        self._turn = 0.0
+        self._dt = 0.0
+        self._dv = self._dw = self._push = self._twist = 0.0
 
     def command(self, linear: float, angular: float) -> str | None:
         """Set the velocity command; return a warning text when it had to be clamped or dropped."""
@@ -89,49 +98,73 @@ class DiffDriveRobot:
             )
         return None
 
-    def _velocity(
-        self, body: pymunk.Body, gravity: tuple[float, float], damping: float, dt: float
-    ) -> None:
-        dv = self._accel * dt
-        dw = self._alpha * dt
+    def before_step(self, dt: float) -> None:
+        """Ramp the velocity towards the command and have this step's physics reach it.
+
+        The velocity is set as a force for the one step (pymunk clears forces after each):
+        the solver still acts on it afterwards, so contacts stop the robot, and no Python
+        velocity callback runs inside the step. Pymunk turns the body first (by its current
+        angular velocity) and integrates velocities after, so the linear velocity is aimed
+        along the heading the body will have then.
+        """
+        if dt != self._dt:
+            self._prepare(dt)
+        dv, dw = self._dv, self._dw
         target_v, target_w = self.target
         v = self.v + max(-dv, min(dv, target_v - self.v))
         w = self.w + max(-dw, min(dw, target_w - self.w))
         self.v, self.w = v, w
-        c_body = self._c_body
-        angle = _LIB.cpBodyGetAngle(c_body)
-        _LIB.cpBodySetVelocity(c_body, (v * math.cos(angle), v * math.sin(angle)))
-        _LIB.cpBodySetAngularVelocity(c_body, w)
+        turn = self._turn
+        heading = self._angle + turn * dt
+        push, twist = self._push, self._twist
+        vx, vy = self._velocity
+        _LIB.cpBodySetForce(
+            self._c_body, ((v * math.cos(heading) - vx) * push, (v * math.sin(heading) - vy) * push)
+        )
+        _LIB.cpBodySetTorque(self._c_body, (w - turn) * twist)
+        if self.contacts or self._gripping:
+            self._grip(heading, dt)
 
-    def before_step(self, dt: float) -> None:
+    def _prepare(self, dt: float) -> None:
+        """What a step of ``dt`` takes that does not change from step to step."""
+        body = self.body
+        self._dt = dt
+        self._dv = self._accel * dt
+        self._dw = self._alpha * dt
+        self._push = body.mass / dt  # force that changes the velocity by 1 m/s in one step
+        self._twist = body.moment / dt
+
+    def _grip(self, heading: float, dt: float) -> None:
         """Put the wheels' grip along the heading, through where the robot is about to be.
 
         pymunk moves the body first and solves the constraints after, so the groove goes
         where this step's motion takes the body, along the heading it will have there.
         """
-        if not self.contacts:  # driving free: nothing to do (the common case)
-            if self._gripping:
-                self._space.remove(self.grip)
-                self._gripping = False
+        if not self.contacts:  # driving free again
+            self._space.remove(self.grip)
+            self._gripping = False
             return
-        body = self.body
-        x = body.position.x + body.velocity.x * dt
-        y = body.position.y + body.velocity.y * dt
-        angle = body.angle + body.angular_velocity * dt
-        dx, dy = GROOVE * math.cos(angle), GROOVE * math.sin(angle)
+        vx, vy = self._velocity
+        x = self._x + vx * dt
+        y = self._y + vy * dt
+        dx, dy = GROOVE * math.cos(heading), GROOVE * math.sin(heading)
         self.grip.groove_a = (x - dx, y - dy)
         self.grip.groove_b = (x + dx, y + dy)
         if not self._gripping:
             self._space.add(self.grip)
             self._gripping = True
 
-    def after_step(self, dt: float) -> None:
-        """Advance the wheel joints with the motion the solver allowed."""
+    def after_step(self, dt: float) -> float:
+        """Read the body back, advance the wheel joints; return the distance it moved."""
         c_body = self._c_body
-        angle = _LIB.cpBodyGetAngle(c_body)
+        position = _LIB.cpBodyGetPosition(c_body)
         velocity = _LIB.cpBodyGetVelocity(c_body)
-        forward = velocity.x * math.cos(angle) + velocity.y * math.sin(angle)
-        w = _LIB.cpBodyGetAngularVelocity(c_body)
+        angle = self._angle = _LIB.cpBodyGetAngle(c_body)
+        w = self._turn = _LIB.cpBodyGetAngularVelocity(c_body)
+        x, y, vx, vy = position.x, position.y, velocity.x, velocity.y
+        moved = math.hypot(x - self._x, y - self._y)
+        self._x, self._y, self._velocity = x, y, (vx, vy)
+        forward = vx * math.cos(angle) + vy * math.sin(angle)
         half, radius = self._half, self._radius
         left = (forward - w * half) / radius
         right = (forward + w * half) / radius
@@ -139,24 +172,19 @@ class DiffDriveRobot:
         rates[0], rates[1] = left, right
         wheels[0] += left * dt
         wheels[1] += right * dt
+        return moved
 
     @property
     def pose(self) -> tuple[float, float, float]:
         """(x, y, yaw) in the world."""
-        c_body = self._c_body
-        position = _LIB.cpBodyGetPosition(c_body)
-        return (position.x, position.y, _LIB.cpBodyGetAngle(c_body))
+        return (self._x, self._y, self._angle)
 
     def odometry(self) -> tuple[tuple[float, float, float], tuple[float, float]]:
         """((x, y, yaw) in the odom frame, (forward speed, yaw rate))."""
         x0, y0, yaw0 = self.spec.pose
-        x, y, yaw = self.pose
+        x, y, yaw = self._x, self._y, self._angle
         c, s = math.cos(-yaw0), math.sin(-yaw0)
         dx, dy = x - x0, y - y0
-        c_body = self._c_body
-        velocity = _LIB.cpBodyGetVelocity(c_body)
-        forward = velocity.x * math.cos(yaw) + velocity.y * math.sin(yaw)
-        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (
-            forward,
-            _LIB.cpBodyGetAngularVelocity(c_body),
-        )
+        vx, vy = self._velocity
+        forward = vx * math.cos(yaw) + vy * math.sin(yaw)
+        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (forward, self._turn)

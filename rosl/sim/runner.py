@@ -27,6 +27,11 @@ def check_options(options: SimOptions) -> None:
         )
     if options.duration is not None and options.duration <= 0:
         raise SimError(f"--duration must be greater than 0 seconds, not {options.duration:g}")
+    if not options.clock_rate > 0:  # also NaN
+        raise SimError(
+            f"--clock-rate must be greater than 0 Hz, not {options.clock_rate:g} "
+            "(a rate at or above the physics rate publishes /clock every step)"
+        )
     if options.lockstep_timeout <= 0:
         raise SimError("--lockstep-timeout must be greater than 0 seconds")
     if options.render is not None and options.render.suffix.lower() not in (".svg", ".png"):

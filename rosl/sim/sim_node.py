@@ -1,11 +1,13 @@
 """The sim node: a :class:`Simulation` on the bus, paced, free-running or in lock-step.
 
-It publishes ``/clock`` every physics step, and per robot odometry with ``odom ->
-base_footprint`` on ``/tf``, joint states (and the wheels on ``/tf``, as robot_state_publisher
-would), scans, and once (transient local) ``/tf_static``, ``robot_description`` and the
-world's geometry on ``/world_markers``; it drives each robot from its ``cmd_vel``. A topic
-nobody subscribes to is not computed nor sent (except ``/clock``): skipping it changes
-nothing else that is published.
+It publishes ``/clock`` at ``clock_rate`` Hz of sim time (10 by default, as gazebo_ros's
+``publish_rate``, which counts wall time; at or above the physics rate: every step) and on
+every step that publishes sensor data, so a subscriber's time is never behind a stamp it has
+received; per robot odometry with ``odom -> base_footprint`` on ``/tf``, joint states (and
+the wheels on ``/tf``, as robot_state_publisher would), scans, and once (transient local)
+``/tf_static``, ``robot_description`` and the world's geometry on ``/world_markers``; it
+drives each robot from its ``cmd_vel``. A topic nobody subscribes to is not computed nor
+sent (except ``/clock``): skipping it changes nothing else that is published.
 
 Modes: paced at ``real_time_factor`` x wall time (default 1); ``fast``: lock-step (see
 :mod:`rosl.node.lockstep`) - each step's messages are handled by the controllers before the
@@ -14,11 +16,11 @@ messages go out before ``/clock``, so a timer woken by the new time sees the ste
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
 
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
-small messages join their topic's batch, which this thread sends once a millisecond of wall
-time and before it sleeps (sensors first, ``/clock`` last; no timer thread contends for the
-GIL), and the bus is served at that pace rather than every step: a datagram per step per topic
-would cost more than the physics. Lock-step and recording
-keep one datagram per message and serve the bus every step.
+messages wait in their topic's list, which this thread publishes as one batch once a
+millisecond of wall time and before it sleeps (sensors first, ``/clock`` last; no timer thread
+contends for the GIL), and the bus is served at that pace rather than every step: a datagram,
+or even a publish call, per step per topic would cost more than the physics. Lock-step and
+recording keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.sim import messages as build
 from rosl.sim.report import RobotReport, SimReport
+from rosl.sim.simulation import Schedule
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -54,8 +57,9 @@ class _Topic:
     def __init__(self, sim_node: SimNode, publisher: Publisher, always: bool = False) -> None:
         self.sim_node = sim_node
         self.publisher = publisher
-        self.always = always
+        self.always = always or sim_node._publish_all
         self._publish = publisher.publish
+        self._pending: list[bytes] = []
 
     def wanted(self) -> bool:
         return self.always or self.sim_node.subscribed(self.publisher.topic)
@@ -69,6 +73,19 @@ class _Topic:
     def free(self) -> None:
         """No lock-step: sending is publishing, one call less per message."""
         self.send = self._publish  # type: ignore[method-assign,assignment]
+
+    def queue(self) -> None:
+        """Batched: messages wait in a list until :meth:`flush` publishes them all at once."""
+        self.publisher.hold_until_flush()
+        self.send = self._pending.append  # type: ignore[method-assign,assignment]
+
+    def flush(self) -> None:
+        """Publish what waits as the publisher's batch, and send it (its only messages)."""
+        pending = self._pending
+        if pending:
+            self.publisher.publish_all(pending)
+            pending.clear()
+            self.publisher.flush()
 
 
 @dataclass(slots=True)
@@ -113,10 +130,18 @@ class SimNode:
         self._generation = -1
         self._warned: dict[str, int] = {}
         self._told: dict[int, int] = {}  # id(writer) -> last sequence number the recorder saw
-        self._next_event = 0.0  # sim ns of the next sensor or odometry firing
+        self._next_event = 0.0  # sim ns of the next firing of a sensor, odometry or /clock
+        self._clock_schedule = Schedule(options.clock_rate)
+        self._schedules = [self._clock_schedule] + [
+            schedule
+            for r in sim.robots
+            for schedule in (r.odom, r.joints, *(s for _, s in r.lidars))
+            if schedule is not None
+        ]
         node.get_clock().set_sim_time(True)  # the sim's own stamps (its /rosout) are sim time
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self._batched = not options.fast and options.record is None
+        self._flushed: list[_Topic] = []  # batched: the sensors' topics first, /clock last
         self.clock = _Topic(
             self,
             node.create_publisher(build.msg("rosgraph_msgs/msg/Clock"), "/clock", 10),
@@ -225,47 +250,44 @@ class SimNode:
         """Publish what is due at the current sim time; ``/clock`` last."""
         sim = self.sim
         now = sim.now_ns
-        if now < self._next_event:  # most steps: only the time moves on
-            self._send_clock(build.clock_bytes(now))
+        if now < self._next_event:  # most steps: nothing is due, not even /clock
             return
+        clock = self._clock_schedule
+        if now >= clock.at_ns:
+            clock.fire(now)
         sampled = False
         transforms: list[build.Transform] = []
         for topics in self.robots:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
-            if sim_robot.odom.due(now):
-                sim_robot.odom.fire(now)
+            odom = sim_robot.odom
+            if now >= odom.at_ns:
+                odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
-                odom = sim_robot.robot.odometry()
+                state = sim_robot.robot.odometry()
                 if topics.odom.wanted():
-                    topics.odom.send(encoder.odometry(now, odom))
-                transforms.append(encoder.odom_transform(odom))
-            if sim_robot.joints is not None and sim_robot.joints.due(now):
-                sim_robot.joints.fire(now)
+                    topics.odom.send(encoder.odometry(now, state))
+                transforms.append(encoder.odom_transform(state))
+            joints = sim_robot.joints
+            if joints is not None and now >= joints.at_ns:
+                joints.fire(now)
                 if topics.joints is not None and topics.joints.wanted():
                     topics.joints.send(encoder.joint_states(now))
                 transforms += encoder.wheel_transforms()
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
-                if schedule.due(now):
+                if now >= schedule.at_ns:
                     index = schedule.fire(now)
-                    if topic.wanted() or self.options.render is not None:
+                    wanted = topic.wanted()
+                    if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
-                        if topic.wanted():
+                        if wanted:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
         if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
             self.tf.send(build.tf_bytes(transforms, now))
-        self.clock.send(build.clock_bytes(now))
-        self._next_event = min(
-            [r.odom.at_ns for r in sim.robots]
-            + [r.joints.at_ns for r in sim.robots if r.joints is not None]
-            + [schedule.at_ns for r in sim.robots for _, schedule in r.lidars],
-            default=math.inf,
-        )
-
-    def _send_clock(self, data: bytes) -> None:
-        self.clock.send(data)
+        self.clock.send(build.clock_bytes(now))  # with every step's data, and at clock_rate
+        self._next_event = min([schedule.at_ns for schedule in self._schedules])
 
     # --- running -----------------------------------------------------------------------------
 
@@ -289,10 +311,10 @@ class SimNode:
         else:
             for topic in self._stepped():
                 topic.free()
-            self._send_clock = self.clock.send  # type: ignore[method-assign,assignment]
         if self._batched:
             for topic in self._stepped():
-                topic.publisher.hold_until_flush()
+                topic.queue()
+            self._flushed = list(reversed(self._stepped()))
         self.publish_static()
         self._announce()
         self._wait_for_peers()
@@ -331,6 +353,7 @@ class SimNode:
         sim, tick, step = self.sim, self.tick, self.sim.step
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
+        end = math.inf if end_ns is None else end_ns
         status_at = started + 1.0
         serve_at = 0.0
         while True:
@@ -344,18 +367,20 @@ class SimNode:
                 if live and wall >= status_at:
                     status_at += 1.0
                     self._status(started)
-            if end_ns is not None and sim.now_ns >= end_ns:
+            now = sim.now_ns
+            if now >= end:
                 return
-            if started + (sim.now_ns + sim.step_ns) / scale > wall:
+            if started + (now + sim.step_ns) / scale > wall:
                 self._pace(started)
             step()
-            tick()
+            if sim.now_ns >= self._next_event:  # most steps publish nothing: no call
+                tick()
 
     def _flush(self) -> None:
         """Paced: send what the batches hold, the sensors' first and ``/clock`` last."""
         if self._batched:
-            for topic in reversed(self._stepped()):
-                topic.publisher.flush()
+            for topic in self._flushed:
+                topic.flush()
 
     def _stepped(self) -> list[_Topic]:
         """The topics published as the simulation steps."""

@@ -9,6 +9,7 @@ seeds its noise, so skipping scans nobody listens to changes nothing that is pub
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -16,7 +17,7 @@ from typing import TYPE_CHECKING
 import pymunk
 
 from rosl.sim import lidar as lidar_cast
-from rosl.sim.robot import DiffDriveRobot
+from rosl.sim.robot import _FFI, _LIB, DiffDriveRobot
 from rosl.sim.world import Geometry, WorldSpace
 from rosl.sim.worldfile import Circle, Polygon
 
@@ -51,8 +52,12 @@ class Schedule:
     def fire(self, now_ns: int) -> int:
         """Take the due firing; return its k. Firings missed in one step are skipped."""
         index = self.index
-        self.index = max(index + 1, math.floor(now_ns * self.rate / NS) + 1)
-        self.at_ns = self._at(self.index)
+        after = index + 1
+        at_ns = round(after * NS / self.rate)  # due, so the rate is positive
+        if now_ns >= at_ns:  # that one is due too: skip to the first after now
+            after = max(after, math.floor(now_ns * self.rate / NS) + 1)
+            at_ns = round(after * NS / self.rate)
+        self.index, self.at_ns = after, at_ns
         return index
 
 
@@ -68,7 +73,6 @@ class SimRobot:
     distance: float = 0.0
     closest: float = math.inf
     collisions: int = 0
-    last_xy: tuple[float, float] = (0.0, 0.0)
     last_scan: tuple[int, np.ndarray] | None = None
 
     @property
@@ -86,7 +90,7 @@ class Simulation:
         self.space = WorldSpace(world)
         self.step_ns = world.step_ns
         self._dt = self.step_ns / NS
-        self._space_step = self.space.space.step
+        self._space_step = self._first_space_step
         self.now_ns = 0
         self.steps = 0
         self.robots: list[SimRobot] = []
@@ -101,13 +105,14 @@ class Simulation:
                     Schedule(model.odom_rate),
                     Schedule(model.joint_states_rate) if model.joint_states_topic else None,
                     [(lidar, Schedule(lidar.rate)) for lidar in model.lidars],
-                    last_xy=spec.pose[:2],
                 )
             )
         self.space.space.on_collision(
             ROBOT_COLLISION, None, begin=self._on_contact, separate=self._on_parting
         )
         self._by_shape = {r.robot.shape: r for r in self.robots}
+        self._c_space = self.space.space._space
+        self._query = _FFI.new("cpPointQueryInfo *")
         for sim_robot in self.robots:
             self._sample(sim_robot)
 
@@ -123,12 +128,14 @@ class Simulation:
         self.now_ns += self.step_ns
         self.steps += 1
         for sim_robot in robots:
-            robot = sim_robot.robot
-            robot.after_step(dt)
-            x, y, _ = robot.pose
-            lx, ly = sim_robot.last_xy
-            sim_robot.distance += math.hypot(x - lx, y - ly)
-            sim_robot.last_xy = (x, y)
+            sim_robot.distance += sim_robot.robot.after_step(dt)
+
+    def _first_space_step(self, dt: float) -> None:
+        """Pymunk's own step (it checks the bodies added since), then chipmunk's directly."""
+        space = self.space.space
+        space.step(dt)
+        if not space._bodies_to_check:  # nothing is added while stepping: skip the wrapper
+            self._space_step = functools.partial(_LIB.cpSpaceStep, space._space)
 
     def _on_contact(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         del space, data
@@ -157,14 +164,20 @@ class Simulation:
         x, y, yaw = sim_robot.robot.pose
         sim_robot.path.append((self.now_ns, x, y, yaw))
         shape = sim_robot.robot.shape
-        query = self.space.space.point_query_nearest((x, y), CLEARANCE_REACH, shape.filter)
-        if query is None:
+        info = self._query
+        if (
+            _LIB.cpSpacePointQueryNearest(
+                self._c_space, (x, y), CLEARANCE_REACH, shape.filter, info
+            )
+            == _FFI.NULL
+        ):  # nothing within reach (pymunk's point_query_nearest, minus its objects)
             return
+        distance = info.distance
         footprint = sim_robot.robot.spec.model.footprint
         if isinstance(footprint, Circle):
-            sim_robot.closest = min(sim_robot.closest, query.distance - footprint.radius)
-        elif query.distance - _circumscribed(footprint) < sim_robot.closest:  # could be closer
-            sim_robot.closest = min(sim_robot.closest, self._clearance(shape, query.distance))
+            sim_robot.closest = min(sim_robot.closest, distance - footprint.radius)
+        elif distance - _circumscribed(footprint) < sim_robot.closest:  # could be closer
+            sim_robot.closest = min(sim_robot.closest, self._clearance(shape, distance))
 
     def _clearance(self, robot: pymunk.Shape, reach: float) -> float:
         """The exact gap between a polygon footprint and the nearest obstacle (0 on contact).

@@ -71,15 +71,16 @@ def footprint_overlaps(robot: RobotSpec, statics: tuple[Shape, ...]) -> str | No
 
 
 class Geometry:
-    """Obstacles as numpy arrays: edges (x1, y1, x2, y2) and circles (x, y, r).
+    """Obstacles as numpy arrays for ray casting: one-sided edges and circles (x, y, r).
 
-    Polygon edges run counter-clockwise, so an edge whose outside faces away from the sensor
-    (one the sensor cannot see first) can be dropped; free segments are seen from both sides.
+    An edge is ``(ax, ay, bx, by, nx, ny, n.a)`` with ``n`` its unit normal on the side it is
+    seen from: polygon edges run counter-clockwise and are seen from outside only; a free
+    segment's side is two edges, one each way, so it is seen from both sides. All of it is
+    computed once, so a scan only asks which edges face the sensor (``n.a - n.s < 0``).
     """
 
     def __init__(self, shapes: tuple[Shape, ...]) -> None:
-        segments: list[tuple[float, float, float, float]] = []
-        closed: list[bool] = []
+        edges: list[tuple[float, float, float, float]] = []
         circles: list[tuple[float, float, float]] = []
         for shape in shapes:
             if isinstance(shape, Circle):
@@ -90,48 +91,36 @@ class Geometry:
                     points.reverse()
                 for k, (x1, y1) in enumerate(points):
                     x2, y2 = points[(k + 1) % len(points)]
-                    segments.append((x1, y1, x2, y2))
-                    closed.append(True)
+                    edges.append((x1, y1, x2, y2))
             elif isinstance(shape, Segment):  # pymunk's capsule: two sides and two round ends
                 (ax, ay), (bx, by) = shape.a, shape.b
                 length = math.hypot(bx - ax, by - ay) or 1.0
                 nx, ny = -(by - ay) / length * shape.radius, (bx - ax) / length * shape.radius
                 for dx, dy in ((nx, ny), (-nx, -ny)):
-                    segments.append((ax + dx, ay + dy, bx + dx, by + dy))
-                    closed.append(False)
+                    edges.append((ax + dx, ay + dy, bx + dx, by + dy))  # seen from both sides
+                    edges.append((bx + dx, by + dy, ax + dx, ay + dy))
                 circles += [(ax, ay, shape.radius), (bx, by, shape.radius)]
-        self.segments = np.array(segments, dtype=np.float64).reshape(-1, 4)
-        self.closed = np.array(closed, dtype=bool)
+        ends = np.array(edges, dtype=np.float64).reshape(-1, 4)
+        ex, ey = ends[:, 2] - ends[:, 0], ends[:, 3] - ends[:, 1]
+        sizes = np.hypot(ex, ey)
+        kept = sizes > 0
+        ends, ex, ey, sizes = ends[kept], ex[kept], ey[kept], sizes[kept]
+        normal_x, normal_y = ey / sizes, -ex / sizes  # outward for a counter-clockwise edge
+        offset = normal_x * ends[:, 0] + normal_y * ends[:, 1]
+        self.edges = np.column_stack((ends, normal_x, normal_y, offset))
+        self.normal_angles = np.arctan2(normal_y, normal_x)
         self.circles = np.array(circles, dtype=np.float64).reshape(-1, 3)
-        seg = self.segments  # what near() needs of each edge, computed once
-        self._x1, self._y1 = seg[:, 0].copy(), seg[:, 1].copy()
-        self._ex, self._ey = seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1]
-        self._length2 = np.maximum(self._ex * self._ex + self._ey * self._ey, 1e-18)
-        self._open = ~self.closed
-        self._cx, self._cy = self.circles[:, 0].copy(), self.circles[:, 1].copy()
-        self._radius = self.circles[:, 2].copy()
 
-    def near(
-        self, x: float, y: float, reach: float, *, facing: bool = False
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The segments and circles that could be hit within ``reach`` of (x, y).
-
-        With ``facing``, polygon edges whose outside faces away from (x, y) are left out.
-        """
-        seg = self.segments
-        if len(seg):
-            ex, ey, x1, y1 = self._ex, self._ey, self._x1, self._y1
-            rx, ry = x - x1, y - y1
-            t = np.minimum(np.maximum((rx * ex + ry * ey) / self._length2, 0.0), 1.0)
-            dx, dy = x1 + t * ex - x, y1 + t * ey - y
-            keep = dx * dx + dy * dy <= reach * reach
-            if facing:  # outward normal of a ccw edge is (ey, -ex); the sensor must be outside
-                keep &= (rx * ey - ry * ex > 0.0) | self._open
-            seg = seg[keep]
-        cir = self.circles
-        if len(cir):
-            cir = cir[np.hypot(self._cx - x, self._cy - y) - self._radius <= reach]
-        return seg, cir
+    @classmethod
+    def joined(cls, geometries: list[Geometry]) -> Geometry:
+        """One geometry holding the edges and circles of several."""
+        if len(geometries) == 1:
+            return geometries[0]
+        joined = cls(())
+        joined.edges = np.concatenate([g.edges for g in geometries])
+        joined.normal_angles = np.concatenate([g.normal_angles for g in geometries])
+        joined.circles = np.concatenate([g.circles for g in geometries])
+        return joined
 
 
 class WorldSpace:

@@ -142,6 +142,30 @@ def test_a_big_message_after_small_ones_keeps_its_place(counted: Counted) -> Non
     assert [d.seq for d in got] == [1, 2, 3, 4]
 
 
+def test_send_all_numbers_batches_and_bounds_like_one_send_each(domain_id: int) -> None:
+    # a thousand messages in one call: the same numbers, size bound and splits as send()'s
+    counted = Counted(domain_id, delay_s=60.0)
+    try:
+        writer = counted.bus.writer
+        writer.send(b"first")
+        payloads = [payload_of(64, seed=n) for n in range(1000)]
+        writer.send_all(payloads)
+        writer.send_all([payload_of(200_000, seed=9), b"after"])  # too big: each its own send
+        counted.flusher.flush()
+        got = counted.bus.collector.wait_count(1003, timeout=20.0)
+        everything = [b"first", *payloads, payload_of(200_000, seed=9), b"after"]
+        assert [bytes(d.payload) for d in got] == everything
+        assert [d.seq for d in got] == list(range(1, 1004))
+        assert (writer.sent, writer.last_seq) == (1003, 1003)
+        batches = batched_records(
+            [d for d in counted.datagrams() if HEADER.unpack_from(d)[3] & Flags.BATCH]
+        )
+        assert all(sum(RECORD.size + len(r[2]) for r in b) <= LIMIT for b in batches)
+        assert [r[0] for b in batches for r in b] == [*range(1, 1002), 1003]
+    finally:
+        counted.close()
+
+
 def test_gaps_inside_batches_are_counted_as_lost(counted: Counted) -> None:
     for seq in (1, 2, 5, 6, 9):
         counted.bus.writer.send(b"m", seq=seq)

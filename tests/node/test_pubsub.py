@@ -405,3 +405,30 @@ def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(r
     for k in range(5):
         child.expect(f"^heard: held {k}$")
     child.expect("^heard: after$")
+
+
+@pytest.mark.parametrize("held", [True, False], ids=["held", "plain"])
+def test_publish_all_sends_serialized_messages_in_order_as_publish_would(ros, spawn, held):
+    from std_msgs.msg import String
+
+    from rosl.idl import registry
+
+    child = spawn(ECHO)  # prints what it hears on "ping"
+    child.expect("^ready$")
+    node = ros.Node("queuer")
+    pub = node.create_publisher(String, "ping", 10)
+    assert spin_until(node, lambda: pub.get_subscription_count() > 0, 20.0)
+    pub.publish(String(data="probe"))
+    child.expect("^heard: probe$")
+    if held:
+        pub.hold_until_flush()
+    store = registry.store()
+    pub.publish_all([bytes(store.serialize(String(data=f"queued {k}"))) for k in range(5)])
+    pub.publish_all([])  # nothing to send: nothing changes
+    if held:
+        spin_for(node, 1.0)
+        assert child.count("^heard: queued") == 0  # held until the flush
+        pub.flush()
+    for k in range(5):
+        child.expect(f"^heard: queued {k}$")
+    assert pub.record().stats["sent"] == 6

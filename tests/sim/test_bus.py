@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 import time
@@ -183,3 +184,30 @@ def test_rosl_sim_stops_after_its_duration_and_prints_a_summary(rosl: Rosl) -> N
     assert code == 0, err
     assert re.search(r"simulated 1\.00 s of turtlebot3_world", out), out
     assert re.search(r"burger: drove 0\.00 m, .* no collisions; ends at x=-2\.00 y=-0\.50", out)
+
+
+@pytest.mark.parametrize(("rate", "every_ms"), [(None, 100), (1000.0, 10)], ids=["default", "fast"])
+def test_clock_goes_out_at_its_rate_and_with_every_steps_data(
+    rosl: Rosl, tmp_path: Path, rate: float | None, every_ms: int
+) -> None:
+    from tests.sim.conftest import read_bag, stamp_ns
+
+    bag = tmp_path / "run"
+    chosen = [] if rate is None else ["--clock-rate", str(rate)]
+    code, out, err = rosl.run(
+        "sim", "empty", "--fast", "--startup-timeout", "0.1", "--duration", "2", "--headless",
+        "--record", str(bag), *chosen, timeout=120.0,
+    )  # fmt: skip
+    assert code == 0, out + err
+    recorded = read_bag(bag, "/clock", "/odom", "/scan")
+    clock = [m.clock.sec * 10**9 + m.clock.nanosec for topic, _, m in recorded if topic == "/clock"]
+    data = {stamp_ns(m.header) for topic, _, m in recorded if topic != "/clock"}
+    assert clock == sorted(clock)
+    assert data
+    assert data <= set(clock)  # a subscriber's time is never behind a stamp it has received
+    gaps = {b - a for a, b in itertools.pairwise(clock)}
+    assert max(gaps) <= every_ms * 1_000_000
+    if rate is None:  # 10 Hz and the 30 Hz odometry's steps: far fewer than the 200 steps
+        assert 60 <= len(clock) < 120, clock
+    else:  # at or above the 100 Hz physics: every step
+        assert clock == list(range(0, 2 * 10**9 + 1, 10_000_000))

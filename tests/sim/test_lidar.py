@@ -89,6 +89,18 @@ def test_ranges_match_pymunks_segment_queries_at_random_free_poses(name: str, ha
     assert misses > 1000
 
 
+def test_a_one_ray_lidar_matches_pymunks_segment_query() -> None:
+    world = load_world(resolve_world("turtlebot3_world"))
+    space = WorldSpace(world)
+    hits = 0
+    for x, y, yaw in free_poses(space.space, 4.0, 300, seed=11):
+        got = lidar_cast.cast(x, y, yaw, 0.0, 1, 3.5, [space.geometry])
+        want = pymunk_ranges(space.space, x, y, yaw, 0.0, 1, 3.5)
+        assert_same_ranges(got, want, 1e-9)
+        hits += int(np.isfinite(want).sum())
+    assert 100 < hits < 300  # both hits and misses were compared
+
+
 def test_the_full_scan_pipeline_sees_other_robots_and_moved_dynamic_bodies(
     write_world: Callable[..., Path],
 ) -> None:

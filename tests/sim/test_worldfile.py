@@ -140,9 +140,21 @@ def test_the_rosl_sim_package_executable_reports_a_bad_world_in_one_line(
         (["--record", "{full}"], "already exists and is not empty"),
         (["--duration", "0"], "--duration must be greater than 0"),
         (["--fast", "--lockstep-timeout", "0"], "--lockstep-timeout must be greater than 0"),
+        (["--clock-rate", "0"], "--clock-rate must be greater than 0 Hz"),
+        (["--clock-rate", "nan"], "--clock-rate must be greater than 0 Hz"),
         (["no_such_world"], "world 'no_such_world' not found"),
     ],
-    ids=["rtf-zero", "rtf-negative", "gif", "record-full", "duration", "lockstep", "world"],
+    ids=[
+        "rtf-zero",
+        "rtf-negative",
+        "gif",
+        "record-full",
+        "duration",
+        "lockstep",
+        "clock-zero",
+        "clock-nan",
+        "world",
+    ],
 )
 def test_rosl_sim_refuses_bad_options_in_one_line_before_starting(
     rosl: Rosl, tmp_path: Path, options: list[str], fragment: str
