@@ -184,8 +184,12 @@ class Subscription(Queued):
             self._run_queued()
             return
         deadline = time.monotonic() + wait
-        while not group.beginning_execution(self):
-            if not self._ready() or time.monotonic() >= deadline:
+        while True:  # (a wake-up without work would make a waiting caller look again at once)
+            if not self._ready():
+                return
+            if group.beginning_execution(self):
+                break
+            if time.monotonic() >= deadline:
                 return
             time.sleep(0.002)
         try:
