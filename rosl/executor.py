@@ -30,7 +30,7 @@ from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
-from rosl.node.callback_groups import holding
+from rosl.node.callback_groups import held_groups
 from rosl.node.task import Future, Task, current_task
 
 if TYPE_CHECKING:
@@ -467,8 +467,15 @@ class Executor:
                 return None
             if entity._is_timer:
                 self._timers_ran += 1
-            with holding(group):
+            if group is None:
                 result = work()
+            else:  # (a drain of the group's subscription on this thread runs inside it)
+                held = held_groups()
+                held.append(group)
+                try:
+                    result = work()
+                finally:
+                    held.pop()
         except Exception as err:
             self._end(entity, group)
             node._callback_failed(err, entity._what)

@@ -99,15 +99,21 @@ class MutuallyExclusiveCallbackGroup(CallbackGroup):
 _held = threading.local()  # .groups: the groups of the callbacks running on this thread
 
 
-@contextlib.contextmanager
-def holding(group: CallbackGroup | None) -> Iterator[None]:
-    """Note that a callback of ``group`` runs on this thread (an executor took the group)."""
-    if group is None:
-        yield
-        return
+def held_groups() -> list[CallbackGroup]:
+    """This thread's stack of the groups its running callbacks hold (push, run, pop)."""
     groups: list[CallbackGroup] | None = getattr(_held, "groups", None)
     if groups is None:
         groups = _held.groups = []
+    return groups
+
+
+@contextlib.contextmanager
+def holding(group: CallbackGroup | None) -> Iterator[None]:
+    """Note that a callback of ``group`` runs on this thread (the group was taken for it)."""
+    if group is None:
+        yield
+        return
+    groups = held_groups()
     groups.append(group)
     try:
         yield
@@ -173,6 +179,7 @@ __all__ = [
     "MutuallyExclusiveCallbackGroup",
     "Queued",
     "ReentrantCallbackGroup",
+    "held_groups",
     "held_here",
     "holding",
 ]

@@ -129,6 +129,9 @@ def test_an_accepted_callback_queues_goals_that_wait_in_the_accepted_state(
     )  # fmt: skip
 
     first = _wait(node, client.send_goal_async(fibonacci.Goal(order=6)))
+    # the server calls the accepted callback after answering (as rclpy's): wait for it, or the
+    # second goal's could come first
+    queue.expect("^executing order 6$")
     second = _wait(node, client.send_goal_async(fibonacci.Goal(order=3)))
     results = [_wait(node, first.get_result_async()), _wait(node, second.get_result_async())]
     ids = (bytes(first.goal_id.uuid), bytes(second.goal_id.uuid))
