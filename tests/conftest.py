@@ -26,6 +26,20 @@ if TYPE_CHECKING:
 REPO = Path(__file__).resolve().parent.parent
 
 
+# the slowest modules, started first so the parallel workers do not end waiting on one of them
+FIRST = ("tests/test_lint.py", "tests/test_packaging.py")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the slowest modules first (the order is otherwise the files' order)."""
+
+    def rank(item: pytest.Item) -> int:
+        path = item.path.relative_to(REPO).as_posix() if REPO in item.path.parents else ""
+        return FIRST.index(path) if path in FIRST else len(FIRST)
+
+    items.sort(key=rank)  # stable: each module keeps its order
+
+
 @pytest.fixture(autouse=True)
 def isolated_search_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Run each test from an empty folder, with no ROSL_PACKAGE_PATH and fresh caches."""
