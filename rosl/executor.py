@@ -30,7 +30,8 @@ from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
-from rosl.node.task import Future, Task
+from rosl.node.callback_groups import held_groups
+from rosl.node.task import Future, Task, current_task
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Coroutine, Iterable
@@ -466,7 +467,15 @@ class Executor:
                 return None
             if entity._is_timer:
                 self._timers_ran += 1
-            result = work()
+            if group is None:
+                result = work()
+            else:  # (a drain of the group's subscription on this thread runs inside it)
+                held = held_groups()
+                held.append(group)
+                try:
+                    result = work()
+                finally:
+                    held.pop()
         except Exception as err:
             self._end(entity, group)
             node._callback_failed(err, entity._what)
@@ -485,12 +494,17 @@ class Executor:
         self, pending: Coroutine[Any, Any, Any], entity: Any, node: Node, group: Any
     ) -> Any:
         """Await a coroutine callback; the group stays taken until it returns."""
+        task = current_task()  # the handler task driving this coroutine
+        if task is not None:
+            task.holds = group
         try:
             return await pending
         except Exception as err:
             node._callback_failed(err, entity._what)
             return None
         finally:
+            if task is not None:
+                task.holds = None
             self._end(entity, group)
 
     def _end(self, entity: Any, group: Any) -> None:

@@ -9,6 +9,7 @@ import os
 import random
 import select
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -23,6 +24,20 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
 REPO = Path(__file__).resolve().parent.parent
+
+
+# the slowest modules, started first so the parallel workers do not end waiting on one of them
+FIRST = ("tests/test_lint.py", "tests/test_packaging.py")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Run the slowest modules first (the order is otherwise the files' order)."""
+
+    def rank(item: pytest.Item) -> int:
+        path = item.path.relative_to(REPO).as_posix() if REPO in item.path.parents else ""
+        return FIRST.index(path) if path in FIRST else len(FIRST)
+
+    items.sort(key=rank)  # stable: each module keeps its order
 
 
 @pytest.fixture(autouse=True)
@@ -97,6 +112,40 @@ def lock_domain() -> tuple[int, IO[str]]:
             continue
         return domain, handle
     pytest.fail("no free test domain id")
+
+
+# --- TCP ports: below the kernel's ephemeral range, each locked by a file --------------------
+
+PORT_LOCK_DIR = Path("/tmp/rosl-test-ports")
+PORTS = range(20000, 30000)  # the ephemeral range (Linux: 32768-60999) never hands these out
+_held_ports: list[IO[str]] = []  # locks kept for the life of this process (a pytest worker)
+
+
+def free_port() -> int:
+    """A TCP port of 127.0.0.1 that nobody listens on and no other test (worker) gets.
+
+    A port the kernel picks for ``bind(0)`` may be picked again for another socket as soon as
+    the probe closes; one from a fixed range, locked by a file, is this test's alone.
+    """
+    PORT_LOCK_DIR.mkdir(exist_ok=True)
+    candidates = list(PORTS)
+    random.shuffle(candidates)
+    for port in candidates:
+        handle = open(PORT_LOCK_DIR / f"{port}.lock", "w")  # noqa: SIM115 - held until exit
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        with socket.socket() as probe:
+            try:
+                probe.bind(("127.0.0.1", port))
+            except OSError:
+                handle.close()
+                continue
+        _held_ports.append(handle)
+        return port
+    pytest.fail("no free test TCP port")
 
 
 @pytest.fixture

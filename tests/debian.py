@@ -2,16 +2,20 @@
 
 :func:`install` runs apt-get when the program is absent and this process may (root, apt-get
 present); it returns the reason it cannot, for the test's skip, or None once it is there.
+One install runs at a time on the machine (a lock file): pytest workers that need a package
+at once would otherwise meet dpkg's lock.
 """
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
 from pathlib import Path
 
 APT_LISTS = Path("/var/lib/apt/lists")
+APT_LOCK = Path("/tmp/rosl-test-apt.lock")
 APT_UPDATE_S = 300
 APT_INSTALL_S = 900
 
@@ -46,6 +50,14 @@ def install(packages: list[str], programs: list[str]) -> str | None:
         return f"{what} missing and cannot be installed: apt-get needs root"
     if shutil.which("apt-get") is None:
         return f"{what} missing and cannot be installed: there is no apt-get here"
+    with APT_LOCK.open("w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # another worker's install ends within its timeouts
+        if all(_present(p) for p in programs):
+            return None  # it installed them meanwhile
+        return _install(packages, programs)
+
+
+def _install(packages: list[str], programs: list[str]) -> str | None:
     command = ["install", "-y", *packages]
     try:
         if not any(APT_LISTS.glob("*_Packages*")):

@@ -27,6 +27,8 @@ if TYPE_CHECKING:
     from rosl.node.callback_groups import CallbackGroup
     from rosl.node.node import Node
 
+FEEDBACK_WAIT = 10.0  # seconds a result waits for a feedback callback running elsewhere
+
 
 class ClientGoalHandle:
     """A goal sent by an :class:`ActionClient` (rclpy.action.client.ClientGoalHandle)."""
@@ -251,8 +253,12 @@ class ActionClient:
             handle._status = int(response.status)
 
     def _drain_feedback(self) -> None:
-        """Run the feedback already received before a result: the server sent it earlier."""
-        self._feedback_sub.drain()
+        """Run the feedback already received before a result: the server sent it earlier.
+
+        Waits (bounded) for a feedback callback running on another thread: the goal's feedback
+        callback is forgotten after this.
+        """
+        self._feedback_sub.drain(wait=FEEDBACK_WAIT)
 
     def _cancel_request(self, handle: ClientGoalHandle) -> Any:
         info = get_message_class("action_msgs/msg/GoalInfo")(goal_id=handle.goal_id)

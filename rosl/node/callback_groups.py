@@ -4,17 +4,25 @@ An executor asks an entity's group ``can_execute`` before offering its callback,
 ``beginning_execution`` / ``ending_execution`` around running it; a custom group subclasses
 :class:`CallbackGroup` and decides all three. Every node has a mutually exclusive default
 group. Entities are kept by weak reference, as in rclpy.
+
+rosl also remembers which groups the callbacks running on a thread hold (:func:`holding`,
+:func:`held_here`): a blocking wait of rosl's own that runs a subscription's callbacks itself
+(:meth:`rosl.node.subscription.Subscription.drain`) takes the group as an executor would, or
+runs them inside the callback of that group which is waiting.
 """
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import weakref
 from typing import TYPE_CHECKING, Any
 
+from rosl.node.task import current_task
+
 if TYPE_CHECKING:
     from collections import deque
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
 
     from rosl.bus.wire import Delivery
 
@@ -88,6 +96,39 @@ class MutuallyExclusiveCallbackGroup(CallbackGroup):
                 self._active = None
 
 
+_held = threading.local()  # .groups: the groups of the callbacks running on this thread
+
+
+def held_groups() -> list[CallbackGroup]:
+    """This thread's stack of the groups its running callbacks hold (push, run, pop)."""
+    groups: list[CallbackGroup] | None = getattr(_held, "groups", None)
+    if groups is None:
+        groups = _held.groups = []
+    return groups
+
+
+@contextlib.contextmanager
+def holding(group: CallbackGroup | None) -> Iterator[None]:
+    """Note that a callback of ``group`` runs on this thread (the group was taken for it)."""
+    if group is None:
+        yield
+        return
+    groups = held_groups()
+    groups.append(group)
+    try:
+        yield
+    finally:
+        groups.pop()
+
+
+def held_here(group: CallbackGroup) -> bool:
+    """Whether a callback of ``group`` is running on this thread (plain or awaiting)."""
+    if group in getattr(_held, "groups", ()):
+        return True
+    task = current_task()  # a coroutine callback keeps its group taken across its awaits
+    return task is not None and task.holds is group
+
+
 class Executable:
     """What executors need of an entity (subscription, timer, service, client, guard, waitable).
 
@@ -138,4 +179,7 @@ __all__ = [
     "MutuallyExclusiveCallbackGroup",
     "Queued",
     "ReentrantCallbackGroup",
+    "held_groups",
+    "held_here",
+    "holding",
 ]

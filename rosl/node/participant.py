@@ -134,7 +134,7 @@ class Participant:
         key = (int(str(message["sender"]), 16), int(cast("int", message["endpoint"])))
         if len(self.asserted) >= MAX_ASSERTING and key not in self.asserted:
             self.asserted.clear()  # strangers' ids must not grow it; live ones assert again
-        self.asserted[key] = time.time_ns()
+        self.asserted[key] = time.monotonic_ns()  # when heard here (a local duration)
 
     def _on_typedef_request(self, message: dict[str, object]) -> None:
         # runs on the discovery thread: someone (a recorder) needs a type this process uses

@@ -65,8 +65,9 @@ class Publisher:
         if self._history is not None:
             participant.add_replayer(topic, self)
         # QoS events (see qos_watch): deadline, lifespan, manual-by-topic liveliness
+        # (local durations: the monotonic clock, which no clock step moves)
         self.last_published_ns: int | None = None
-        self.last_asserted_ns = time.time_ns()
+        self.last_asserted_ns = time.monotonic_ns()
         self.alive = True  # a manual-by-topic publisher whose lease has not run out
         self._lifespan_ns = duration_ns(qos.lifespan)
         self._lease_ns = duration_ns(qos.liveliness_lease_duration)
@@ -89,7 +90,7 @@ class Publisher:
                 raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
             data = self._store.serialize_view(msg)  # no copy into bytes: any buffer sends
         seq = self._writer.send(data)
-        now = self.last_published_ns = time.time_ns()
+        now = self.last_published_ns = time.monotonic_ns()
         if self._manual:
             self.last_asserted_ns, self.alive = now, True
         if self._history is not None:
@@ -114,7 +115,7 @@ class Publisher:
         """Send the kept history to one late subscriber (transient local)."""
         if self._history is None or self.destroyed:
             return
-        oldest = time.time_ns() - self._lifespan_ns if self._lifespan_ns else 0
+        oldest = time.monotonic_ns() - self._lifespan_ns if self._lifespan_ns else 0
         for seq, stamp, data in list(self._history):
             if stamp < oldest:
                 continue  # past its lifespan: a late subscriber never sees it
@@ -159,7 +160,7 @@ class Publisher:
         Automatic liveliness is asserted by discovery; calls closer together than a quarter
         of the lease (or 50 ms) send nothing more.
         """
-        now = time.time_ns()
+        now = time.monotonic_ns()
         self.last_asserted_ns, self.alive = now, True
         if not self._manual or now - self._announced_ns < max(self._lease_ns // 4, 50_000_000):
             return  # automatic: discovery asserts it

@@ -191,7 +191,7 @@ class QoSWatch:
             self.generation = generation
             for watched in self.watched:
                 self._graph_events(watched, graph)
-        now = time.time_ns()
+        now = time.monotonic_ns()  # what it is compared with is of the same (local) clock
         for watched in self.watched:
             if watched.kind == PUBLISHER:
                 self._publisher_timing(watched, now)

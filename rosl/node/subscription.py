@@ -23,7 +23,7 @@ from rosl.bus.header import Flags, Kind, topic_hash, type_hash
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
-from rosl.node.callback_groups import Queued
+from rosl.node.callback_groups import Queued, held_here, holding
 from rosl.node.qos import HistoryPolicy
 from rosl.node.qos_compatibility import compatible
 
@@ -119,7 +119,8 @@ class Subscription(Queued):
         self.incompatible = 0  # messages of publishers whose QoS does not match (dropped)
         self.expired = 0  # messages older than their publisher's lifespan (dropped)
         self._words = qos.words(subscription=True)
-        self.last_arrival_ns: int | None = None  # for the deadline (see qos_watch)
+        # for the deadline and liveliness (see qos_watch): arrival times on the monotonic clock
+        self.last_arrival_ns: int | None = None
         self.peer_seen: dict[tuple[int, int], int] | None = None  # per publisher, when tracked
         self._warned: set[int] = set()
         self.destroyed = False
@@ -152,27 +153,53 @@ class Subscription(Queued):
                 return  # history asked for by another subscription
         elif kind != _DATA:
             return
-        self.last_arrival_ns = delivery.received
+        now = self.last_arrival_ns = time.monotonic_ns()
         if self.peer_seen is not None:
-            self._seen(delivery)
+            self._seen(delivery, now)
         queue = self._queue
         if len(queue) == queue.maxlen:
             self.dropped += 1
         queue.append(delivery)
 
-    def _seen(self, delivery: Delivery) -> None:
+    def _seen(self, delivery: Delivery, now_ns: int) -> None:
         seen = self.peer_seen
         if seen is not None:
             if len(seen) >= MAX_PEERS:
                 seen.clear()
-            seen[(delivery.sender, delivery.endpoint)] = delivery.received
+            seen[(delivery.sender, delivery.endpoint)] = now_ns
 
-    def drain(self) -> None:
+    def drain(self, wait: float = 0.0) -> None:
         """Run the callback for every delivery queued now, on this thread.
 
         For a blocking wait of rosl's own that needs what already arrived (a TF lookup with a
         timeout, an action's feedback before its result) while no executor may be spinning.
+        The callbacks run under the subscription's callback group as an executor's would: at
+        once in a callback of that group waiting on this thread, else with the group taken
+        here. While another thread runs a callback of the group (a mutually exclusive one),
+        this waits up to ``wait`` seconds for it to end, then leaves the deliveries to the
+        executor that runs the group.
         """
+        group = self.callback_group
+        if group is None or held_here(group):
+            self._run_queued()
+            return
+        deadline = time.monotonic() + wait
+        while True:  # (a wake-up without work would make a waiting caller look again at once)
+            if not self._ready():
+                return
+            if group.beginning_execution(self):
+                break
+            if time.monotonic() >= deadline:
+                return
+            time.sleep(0.002)
+        try:
+            with holding(group):
+                self._run_queued()
+        finally:
+            group.ending_execution(self)
+            self.node.context.wake_executors()  # one may have passed over the busy group
+
+    def _run_queued(self) -> None:
         while not self.destroyed and self._ready():
             work = self._take()
             if work is not None:

@@ -22,6 +22,12 @@ T = TypeVar("T")
 _driving = threading.local()  # .task: the rosl Task whose coroutine this thread is running
 
 
+def current_task() -> Task[Any] | None:
+    """The task whose coroutine this thread is running now (None outside of one)."""
+    task: Task[Any] | None = getattr(_driving, "task", None)
+    return task
+
+
 class Scheduler(Protocol):
     """What a task needs of its executor: to be run again (an executor's ``_schedule``)."""
 
@@ -156,6 +162,7 @@ class Task(Future[T]):
         self._task_lock = threading.Lock()
         self.entity: Any = None  # what an executor's handler task serves, and its node
         self.node: Any = None
+        self.holds: Any = None  # the callback group its coroutine callback keeps taken
 
     def executing(self) -> bool:
         """Whether the task is running right now."""

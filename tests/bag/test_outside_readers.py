@@ -536,7 +536,7 @@ def download_mcap_cli() -> str | None:
     if build is None or platform.system() != "Linux":
         return f"no {MCAP_CLI_RELEASE} binary for {platform.system()} {platform.machine()}"
     url = f"https://github.com/foxglove/mcap/releases/download/{MCAP_CLI_RELEASE}/mcap-{build}"
-    partial = MCAP_CLI_CACHE.with_suffix(".part")
+    partial = MCAP_CLI_CACHE.with_suffix(f".{os.getpid()}.part")  # workers may race
     try:
         MCAP_CLI_CACHE.parent.mkdir(parents=True, exist_ok=True)
         with urllib.request.urlopen(url, timeout=30) as response:

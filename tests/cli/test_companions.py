@@ -11,17 +11,12 @@ import urllib.request
 from typing import TYPE_CHECKING
 
 from tests.bus.helpers import Lines
+from tests.conftest import free_port
 
 if TYPE_CHECKING:
     from pathlib import Path
 
     from tests.conftest import Processes
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def page_state(port: int) -> dict[str, object]:

@@ -23,7 +23,7 @@ import pytest
 
 from rosl.introspection import live_view
 from rosl.introspection.graph_view import Channel, GraphModel
-from tests.conftest import REPO, Processes, lock_domain
+from tests.conftest import REPO, Processes, free_port, lock_domain
 from tests.introspection.conftest import run_chromium
 from tests.launch.support import Output, one_error_line
 
@@ -41,12 +41,6 @@ DRIVE = ("topic", "pub", "/cmd_vel", "geometry_msgs/msg/Twist",
          "{linear: {x: 0.2}, angular: {z: 0.3}}", "-r", "10")  # fmt: skip
 SCAN_RGB = (0x00, 0xBC, 0xD4)  # the scan points' colour, as the PNG draws them
 FOOTPRINT_RGB = (0xFF, 0xD5, 0x4F)
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 @dataclass

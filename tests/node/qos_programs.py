@@ -92,6 +92,8 @@ def tick():
         return
     if count >= cfg.get("count", 1 << 30):
         return
+    if cfg.get("wait_matched") and pub.get_subscription_count() < 1:
+        return  # (its first message goes to a subscription that is there)
     count += 1
     pub.publish(String(data=f"{cfg.get('prefix', 'msg')} {count}"))
     say(f"published {count}")

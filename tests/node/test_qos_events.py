@@ -151,12 +151,15 @@ def test_manual_liveliness_is_lost_when_the_publisher_stops_and_back_when_it_ass
     spawn, tmp_path
 ):
     manual = {"liveliness": "MANUAL_BY_TOPIC", "liveliness_lease_duration": 1.0}
-    talker = start(spawn, tmp_path, TALKER, "talker",
-                   {**manual, "count": 5, "assert_after_lost": 2.0})  # fmt: skip
     listener = start(spawn, tmp_path, LISTENER, "listener", manual)
+    listener.expect(r"^ready$", timeout=BOUND)
+    # it publishes once it sees the listener, for 2 s: two leases for the listener to
+    # discover it while its messages still arrive, however slow the machine is
+    talker = start(spawn, tmp_path, TALKER, "talker",
+                   {**manual, "count": 20, "wait_matched": True, "assert_after_lost": 2.0})  # fmt: skip
 
     listener.expect(r"^liveliness changed alive=1 not_alive=0 ", timeout=BOUND)
-    talker.expect(r"^published 5$", timeout=BOUND)
+    talker.expect(r"^published 20$", timeout=BOUND)
     talker.expect(r"^liveliness lost total=1 change=1$", timeout=BOUND)
     listener.expect(
         r"^liveliness changed alive=0 not_alive=1 alive_change=-1 not_alive_change=1$",
@@ -167,7 +170,7 @@ def test_manual_liveliness_is_lost_when_the_publisher_stops_and_back_when_it_ass
         r"^liveliness changed alive=1 not_alive=0 alive_change=1 not_alive_change=-1$",
         timeout=BOUND,
     )
-    assert talker.count(r"^published 6") == 0
+    assert talker.count(r"^published 21") == 0
 
 
 def test_messages_lost_while_the_subscriber_was_stopped_are_told(spawn, tmp_path):

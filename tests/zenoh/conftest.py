@@ -2,26 +2,18 @@
 
 from __future__ import annotations
 
-import socket
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.conftest import ChildOutput, wait_until
+from tests.conftest import ChildOutput, free_port, wait_until
 
 if TYPE_CHECKING:
     from tests.conftest import Processes
 
 PEER = str(Path(__file__).with_name("peer.py"))
-
-
-def free_port() -> int:
-    """A TCP port of 127.0.0.1 nobody listens on now."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def wait_output(output: ChildOutput, needle: str, timeout: float = 30.0) -> bool:
