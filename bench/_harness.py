@@ -15,7 +15,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 IP_MULTICAST_ALL = 49
-BENCH_DOMAIN = int(os.environ.get("ROSL_BENCH_DOMAIN", "199"))
+# below the tests' domains (20-232, tests/conftest.py), so a bench beside the suite cannot collide
+BENCH_DOMAIN = int(os.environ.get("ROSL_BENCH_DOMAIN", "13"))
 
 
 def raw_receiver(group: str, port: int) -> socket.socket:
