@@ -17,17 +17,19 @@ import socket
 import struct
 import sys
 import threading
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 from rosl.bus import auth as keys
 from rosl.bus.errors import BusError
 from rosl.bus.pacing import pacer_from_env
+from rosl.bus.settings import env_number
 from rosl.bus.transport import CHANNELS
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
@@ -40,6 +42,7 @@ MAX_DOMAIN = 232
 RCVBUF_WANTED = 8 * 1024 * 1024
 RCVBUF_WARN_BELOW = 1024 * 1024
 DRAIN_LIMIT = 1024  # datagrams read from one socket per poll
+BACKLOG_MS = 500  # a socket behind its queues' limit this long is drained whole again
 IP_MULTICAST_ALL = 49  # linux/in.h; not exported by the socket module
 LOOPBACK = "127.0.0.1"
 FIX_HINT = (
@@ -181,6 +184,11 @@ def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
     return sock
 
 
+def backlog_from_env() -> int:
+    """How long (ns) a socket may stay behind its queues: ``ROSL_BACKLOG_MS`` or the default."""
+    return int(max(0.0, env_number("ROSL_BACKLOG_MS", BACKLOG_MS)) * 1_000_000)
+
+
 def _check_rcvbuf(sock: socket.socket) -> None:
     global _warned_rcvbuf
     granted = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2  # linux reports double
@@ -280,6 +288,8 @@ class MulticastReceiver:
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
         self._closed = False
+        self._behind: dict[int, int] = {}  # socket fd -> since when it has had a backlog (ns)
+        self.backlog_ns = backlog_from_env()
 
     def join(self, channel: int) -> None:
         """Open the channel's socket (joining its group) unless it is open."""
@@ -291,11 +301,22 @@ class MulticastReceiver:
         """Close the channel's socket (leaving its group)."""
         with self._lock:
             sock = self._sockets.pop(channel, None)
+            if sock is not None:
+                self._behind.pop(sock.fileno(), None)
         if sock is not None:
             sock.close()
 
-    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
-        """Wait for datagrams (or a wake-up) and append the complete messages to ``out``."""
+    def poll(
+        self,
+        timeout: float | None,
+        out: list[Delivery],
+        channel: int | None = None,
+        limits: Mapping[int, int] | None = None,
+    ) -> int:
+        """Wait for datagrams (or a wake-up) and append the complete messages to ``out``.
+
+        ``limits`` bounds what is read per channel (see :meth:`_drain`).
+        """
         with self._lock:
             if self._closed:
                 return 0
@@ -304,6 +325,7 @@ class MulticastReceiver:
             else:
                 sock = self._sockets.get(channel)
                 watched = [] if sock is None else [sock]
+            channels = {id(sock): number for number, sock in self._sockets.items()}
         if not watched:
             return 0
         try:
@@ -313,18 +335,40 @@ class MulticastReceiver:
         except (OSError, ValueError):
             return 0  # a socket closed under us (shutdown)
         drained = 0
-        drain = self.reader.drain
         for item in ready:
             if isinstance(item, socket.socket):
                 drained += 1
-                # bounded: a sender faster than we parse must not grow ``out`` without end;
-                # what is left stays in the socket for the next poll
-                drain(item.recv, out, DRAIN_LIMIT)
+                limit = None if limits is None else limits.get(channels.get(id(item), -1))
+                self._drain(item, out, limit)
             else:
                 with contextlib.suppress(OSError):
                     while os.read(self._wake_read, 4096):
                         pass
         return drained
+
+    def _drain(self, sock: socket.socket, out: list[Delivery], limit: int | None) -> None:
+        """Read one socket's datagrams: up to ``limit``, and all of them now and then.
+
+        Always bounded (:data:`DRAIN_LIMIT`): a sender faster than we parse must not grow
+        ``out`` without end; what is left stays in the socket for the next poll. With a
+        ``limit`` (the depth of the queues the channel's messages go to), no more is read
+        than they hold: the kernel's receive buffer, megabytes deep, absorbs a burst of many
+        publishers that a 10-deep queue would lose. A socket that stays behind is drained
+        whole once every :data:`BACKLOG_MS` (``ROSL_BACKLOG_MS``), keep-last queues keeping
+        the newest: a slow callback gets fresh messages, not ones that waited seconds in the
+        kernel, and an overloaded process does not spend its time reading messages only to
+        push them out of a queue again.
+        """
+        key = sock.fileno()
+        since = self._behind.get(key)
+        now = time.monotonic_ns()
+        late = since is not None and now - since > self.backlog_ns
+        bound = DRAIN_LIMIT if limit is None or late else max(1, min(limit, DRAIN_LIMIT))
+        if not self.reader.drain(sock.recv, out, bound):
+            if since is not None:
+                del self._behind[key]
+        elif since is None or late:
+            self._behind[key] = now  # behind from now: the next whole drain is a period away
 
     def wake(self) -> None:
         """Wake a thread blocked in :meth:`poll`."""
