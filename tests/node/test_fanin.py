@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 
@@ -147,6 +148,14 @@ def test_loss_from_an_overflowing_socket_is_counted_per_publisher_exactly(spawn,
     assert report["lost"] == sum(p["lost"] for p in publishers)
     assert report["dropped"] == 0  # read no faster than the queue takes: the socket lost them
     assert report["received"] == sum(p["received"] for p in publishers)
+
+    # a user sees it per publisher: topic info -v --stats, on both sides
+    out, _ = spawn.module("rosl", "topic", "info", "/fanin", "-v", "--stats").finish()
+    for index, counted in report["publishers"].items():
+        assert f"  Lost from /fanin_pub_{index}: {counted['lost']}\n" in out, out
+    lost_on_the_way = re.findall(r"^Messages sent: \d+ \(lost on the way: (\d+)\)$", out, re.M)
+    assert sorted(map(int, lost_on_the_way)) == sorted(p["lost"] for p in publishers), out
+    assert re.search(rf"^Messages received: \d+ \(lost: {report['lost']}, dropped: 0,", out, re.M)
 
 
 def test_loss_is_counted_when_a_slow_subscriber_drops_the_backlog_for_fresh_messages(
