@@ -75,6 +75,7 @@ def raw_recv(publishers: int) -> None:
     sock.setblocking(False)
     granted = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2
     got = [0] * publishers
+    cpu = time.process_time()
     buf = bytearray(65536)
     print("ready", flush=True)
     while True:
@@ -92,7 +93,10 @@ def raw_recv(publishers: int) -> None:
         if sys.stdin in ready:
             sys.stdin.readline()
             break
-    print(json.dumps({"received": got, "rcvbuf": granted}), flush=True)
+    print(
+        json.dumps({"received": got, "rcvbuf": granted, "cpu": time.process_time() - cpu}),
+        flush=True,
+    )
 
 
 def raw_send(index: int, hz: float, size: int) -> None:
@@ -101,6 +105,7 @@ def raw_send(index: int, hz: float, size: int) -> None:
     payload = bytearray(max(size, RAW_HEAD.size))
     print("ready", flush=True)
     start, end = _wait_go()
+    cpu = time.process_time()
     period = 1.0 / hz
     sent = 0
     while True:
@@ -114,7 +119,7 @@ def raw_send(index: int, hz: float, size: int) -> None:
         with contextlib.suppress(BlockingIOError):
             sock.sendto(payload, (group, port))
         sent += 1
-    print(json.dumps({"sent": sent}), flush=True)
+    print(json.dumps({"sent": sent, "cpu": time.process_time() - cpu}), flush=True)
 
 
 # --- rosl --------------------------------------------------------------------------------------
@@ -136,6 +141,7 @@ def rosl_sub(depth: int) -> None:
     executor = rosl.SingleThreadedExecutor()
     executor.add_node(node)
     print("ready", flush=True)
+    cpu = time.process_time()
     while not _stdin_says_stop(0.0):
         executor.spin_once(timeout_sec=0.05)
     quiet_since, before = time.monotonic(), count[0]
@@ -147,6 +153,7 @@ def rosl_sub(depth: int) -> None:
     per = [{"received": s.received, "lost": s.lost} for s in reader.streams.values()]
     print(json.dumps({
         "received": count[0], "lost": sub.lost, "dropped": sub.dropped, "streams": per,
+        "cpu": time.process_time() - cpu,
     }), flush=True)  # fmt: skip
     rosl.shutdown()
 
@@ -163,6 +170,7 @@ def rosl_pub(index: int, hz: float, size: int) -> None:
     sent = [0]
     print("ready", flush=True)
     start, end = _wait_go()
+    cpu = time.process_time()
     time.sleep(max(0.0, start - time.time()))
 
     def tick() -> None:
@@ -175,7 +183,7 @@ def rosl_pub(index: int, hz: float, size: int) -> None:
     executor.add_node(node)
     while time.time() < end:
         executor.spin_once(timeout_sec=max(0.0, end - time.time()))
-    print(json.dumps({"sent": sent[0]}), flush=True)
+    print(json.dumps({"sent": sent[0], "cpu": time.process_time() - cpu}), flush=True)
     rosl.shutdown()
 
 
@@ -225,10 +233,12 @@ def run(kind: str, args: argparse.Namespace) -> tuple[int, dict[str, Any]]:
         start = time.time() + 0.5
         for child in senders:
             _tell(child, f"go {start} {start + args.seconds}")
-        sent = sum(_result(child, args.seconds + 60)["sent"] for child in senders)
+        results = [_result(child, args.seconds + 60) for child in senders]
         time.sleep(0.5)  # what is in flight arrives (rosl's subscriber then reads until quiet)
         _tell(receiver, "stop")
-        return sent, _result(receiver)
+        got = _result(receiver)
+        got["senders_cpu"] = sum(r["cpu"] for r in results)
+        return sum(r["sent"] for r in results), got
     finally:
         for child in [*senders, receiver]:
             stop(child)
@@ -267,6 +277,13 @@ def main() -> None:
                 f"loss {loss:.2f} %  counted by rosl: {got['lost']} gaps + {got['dropped']} "
                 f"queue drops = {counted} of {true_loss} lost; streams {len(got['streams'])}"
             )
+            for name, what, n in (("raw", raw, raw_sent), ("rosl", got, sent)):
+                print(
+                    f"run {run_index + 1}: {name:<5} CPU per message: senders "
+                    f"{1e6 * what['senders_cpu'] / max(1, n):.0f} us, receiver "
+                    f"{1e6 * what['cpu'] / max(1, n):.0f} us; senders reached "
+                    f"{100 * n / (args.publishers * args.hz * args.seconds):.0f} % of their rate"
+                )
             points.append(loss - raw_loss)
             print(f"run {run_index + 1}: rosl - raw = {loss - raw_loss:+.2f} points", flush=True)
     finally:
