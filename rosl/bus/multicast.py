@@ -17,7 +17,6 @@ import socket
 import struct
 import sys
 import threading
-import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
@@ -42,7 +41,7 @@ MAX_DOMAIN = 232
 RCVBUF_WANTED = 8 * 1024 * 1024
 RCVBUF_WARN_BELOW = 1024 * 1024
 DRAIN_LIMIT = 1024  # datagrams read from one socket per poll
-BACKLOG_MS = 500  # a socket behind its queues' limit this long is drained whole again
+BACKLOG_MS = 500  # a message that waited this long in a socket: the rest is read at once
 IP_MULTICAST_ALL = 49  # linux/in.h; not exported by the socket module
 LOOPBACK = "127.0.0.1"
 FIX_HINT = (
@@ -185,7 +184,7 @@ def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
 
 
 def backlog_from_env() -> int:
-    """How long (ns) a socket may stay behind its queues: ``ROSL_BACKLOG_MS`` or the default."""
+    """How long (ns) messages may wait in a socket for a queue: ``ROSL_BACKLOG_MS`` or default."""
     return int(max(0.0, env_number("ROSL_BACKLOG_MS", BACKLOG_MS)) * 1_000_000)
 
 
@@ -288,7 +287,6 @@ class MulticastReceiver:
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
         self._closed = False
-        self._behind: dict[int, int] = {}  # socket fd -> since when it has had a backlog (ns)
         self.backlog_ns = backlog_from_env()
 
     def join(self, channel: int) -> None:
@@ -301,8 +299,6 @@ class MulticastReceiver:
         """Close the channel's socket (leaving its group)."""
         with self._lock:
             sock = self._sockets.pop(channel, None)
-            if sock is not None:
-                self._behind.pop(sock.fileno(), None)
         if sock is not None:
             sock.close()
 
@@ -347,28 +343,25 @@ class MulticastReceiver:
         return drained
 
     def _drain(self, sock: socket.socket, out: list[Delivery], limit: int | None) -> None:
-        """Read one socket's datagrams: up to ``limit``, and all of them now and then.
+        """Read one socket's datagrams: up to ``limit``, unless those waiting are stale.
 
         Always bounded (:data:`DRAIN_LIMIT`): a sender faster than we parse must not grow
         ``out`` without end; what is left stays in the socket for the next poll. With a
         ``limit`` (the depth of the queues the channel's messages go to), no more is read
         than they hold: the kernel's receive buffer, megabytes deep, absorbs a burst of many
-        publishers that a 10-deep queue would lose. A socket that stays behind is drained
-        whole once every :data:`BACKLOG_MS` (``ROSL_BACKLOG_MS``), keep-last queues keeping
-        the newest: a slow callback gets fresh messages, not ones that waited seconds in the
-        kernel, and an overloaded process does not spend its time reading messages only to
-        push them out of a queue again.
+        publishers that a 10-deep queue would lose. But when the last message read waited in
+        the socket longer than :data:`BACKLOG_MS` (``ROSL_BACKLOG_MS``), the rest is read at
+        once and keep-last queues keep the newest: a callback slower than its publishers
+        gets fresh messages, not ones that waited seconds in the kernel.
         """
-        key = sock.fileno()
-        since = self._behind.get(key)
-        now = time.monotonic_ns()
-        late = since is not None and now - since > self.backlog_ns
-        bound = DRAIN_LIMIT if limit is None or late else max(1, min(limit, DRAIN_LIMIT))
-        if not self.reader.drain(sock.recv, out, bound):
-            if since is not None:
-                del self._behind[key]
-        elif since is None or late:
-            self._behind[key] = now  # behind from now: the next whole drain is a period away
+        if limit is None or limit >= DRAIN_LIMIT:
+            self.reader.drain(sock.recv, out, DRAIN_LIMIT)
+            return
+        start = len(out)
+        if self.reader.drain(sock.recv, out, max(1, limit)) and len(out) > start:
+            last = out[-1]
+            if last.received - last.stamp > self.backlog_ns:  # (the sender's stamp)
+                self.reader.drain(sock.recv, out, DRAIN_LIMIT)
 
     def wake(self) -> None:
         """Wake a thread blocked in :meth:`poll`."""

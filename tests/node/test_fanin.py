@@ -161,9 +161,9 @@ def test_loss_from_an_overflowing_socket_is_counted_per_publisher_exactly(spawn,
 def test_loss_is_counted_when_a_slow_subscriber_drops_the_backlog_for_fresh_messages(
     spawn, tmp_path
 ):
-    # the same overflow with the default backlog bound: a subscriber that stays behind
-    # drains its socket whole now and then (keep-last keeps the newest), so some messages
-    # go out of its queue instead; gaps and queue drops together are every lost message
+    # the same overflow with the default backlog bound: messages that waited in the socket
+    # longer than it are read at once (keep-last keeps the newest), so some go out of the
+    # queue instead; gaps and queue drops together are every lost message
     report = fan_in(spawn, tmp_path, count=1500, size=8000, depth=20, env={})
 
     publishers = report["publishers"].values()
