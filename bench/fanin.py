@@ -14,7 +14,8 @@ data channel of the topic, as rosl would use it), from 127.0.0.1 with TTL 0:
 Every sender says how many it sent; loss = 1 - received / sent (the subscriber's callbacks
 for rosl). For rosl it also prints what rosl itself counted and reported: sequence gaps on
 the bus (``Subscription.lost``) plus messages pushed out of a full subscription queue
-(``Subscription.dropped``), which together must equal the true loss. The last line is the
+(``Subscription.dropped``), which together must equal the true loss (less a gap at the very
+end of a stream: it is counted only when the stream goes on). The last line is the
 difference rosl - raw in percentage points (aim: within 1 point).
 
     python bench/fanin.py [--publishers 20] [--hz 1000] [--size 64] [--seconds 5]

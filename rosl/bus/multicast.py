@@ -288,6 +288,7 @@ class MulticastReceiver:
         os.set_blocking(self._wake_write, False)
         self._closed = False
         self.backlog_ns = backlog_from_env()
+        self._caught_up: dict[int, int] = {}  # socket fd -> when stale messages were skipped
 
     def join(self, channel: int) -> None:
         """Open the channel's socket (joining its group) unless it is open."""
@@ -299,6 +300,8 @@ class MulticastReceiver:
         """Close the channel's socket (leaving its group)."""
         with self._lock:
             sock = self._sockets.pop(channel, None)
+            if sock is not None:
+                self._caught_up.pop(sock.fileno(), None)
         if sock is not None:
             sock.close()
 
@@ -352,7 +355,9 @@ class MulticastReceiver:
         publishers that a 10-deep queue would lose. But when the last message read waited in
         the socket longer than :data:`BACKLOG_MS` (``ROSL_BACKLOG_MS``), the rest is read at
         once and keep-last queues keep the newest: a callback slower than its publishers
-        gets fresh messages, not ones that waited seconds in the kernel.
+        gets fresh messages, not ones that waited seconds in the kernel. At most once per
+        bound per socket: a process that cannot keep up at all must not spend its time
+        reading messages only to push them out of a queue again.
         """
         if limit is None or limit >= DRAIN_LIMIT:
             self.reader.drain(sock.recv, out, DRAIN_LIMIT)
@@ -360,7 +365,10 @@ class MulticastReceiver:
         start = len(out)
         if self.reader.drain(sock.recv, out, max(1, limit)) and len(out) > start:
             last = out[-1]
-            if last.received - last.stamp > self.backlog_ns:  # (the sender's stamp)
+            stale = last.received - last.stamp > self.backlog_ns  # (the sender's stamp)
+            key = sock.fileno()
+            if stale and last.received - self._caught_up.get(key, 0) > self.backlog_ns:
+                self._caught_up[key] = last.received
                 self.reader.drain(sock.recv, out, DRAIN_LIMIT)
 
     def wake(self) -> None:
