@@ -67,3 +67,32 @@ def test_messages_that_waited_longer_than_the_bound_are_read_at_once(domain_id):
 
     assert first == BURST  # the limit's worth, then the rest: they were stale
     assert [d.seq for d in got] == list(range(1, BURST + 1))
+
+
+def test_stale_messages_are_skipped_at_most_once_per_bound(domain_id):
+    # messages stamped 15 s before they are sent have waited longer than a 10 s bound; a
+    # second stale burst right after the first skip is read at the queue's pace again
+    transport = MulticastTransport(Addressing(domain_id))
+    try:
+        out = Writer(transport, 0xF00, 3, "/backlog", "std_msgs/msg/String")
+        receiver = transport.receiver()
+        receiver.backlog_ns = 10_000_000_000
+        receiver.reader.wanted.add(out.topic)
+        receiver.join(out.channel)
+        got: list[Delivery] = []
+        out.send(b"fresh")  # opens the stream (its first stamp must be recent)
+        opened = take(receiver, out.channel, got, 10)
+
+        def stale_burst() -> None:
+            for i in range(BURST):
+                out.send(b"message %d" % i, stamp=time.time_ns() - 15_000_000_000)
+
+        stale_burst()
+        first = take(receiver, out.channel, got, 10)
+        stale_burst()
+        second = take(receiver, out.channel, got, 10)
+    finally:
+        transport.close()
+
+    assert (opened, first, second) == (1, BURST, 10)
+    assert [d.seq for d in got] == list(range(1, BURST + 12))
