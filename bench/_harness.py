@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import fcntl
 import os
 import socket
 import statistics
@@ -9,7 +10,8 @@ import struct
 import subprocess
 import sys
 import time
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import IO, TYPE_CHECKING
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -17,6 +19,19 @@ if TYPE_CHECKING:
 IP_MULTICAST_ALL = 49
 # below the tests' domains (20-232, tests/conftest.py), so a bench beside the suite cannot collide
 BENCH_DOMAIN = int(os.environ.get("ROSL_BENCH_DOMAIN", "13"))
+LOCKS = Path("/tmp/rosl-test-domains")  # the test suite's domain locks
+
+
+def lock_domain(domain: int) -> IO[str]:
+    """Hold the test suite's lock of ``domain``, so no test picks it while a bench runs."""
+    LOCKS.mkdir(exist_ok=True)
+    handle = (LOCKS / f"{domain}.lock").open("w")
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        handle.close()
+        raise SystemExit(f"domain {domain} is in use (set ROSL_BENCH_DOMAIN)") from None
+    return handle
 
 
 def raw_receiver(group: str, port: int) -> socket.socket:

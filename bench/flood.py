@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import fcntl
 import random
 import select
 import signal
@@ -50,7 +49,7 @@ import time
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
-from _harness import BENCH_DOMAIN, raw_sender
+from _harness import BENCH_DOMAIN, lock_domain, raw_sender
 from _procs import bench_env, stop
 
 if TYPE_CHECKING:
@@ -60,7 +59,6 @@ DOMAIN = BENCH_DOMAIN + 5
 TOPIC = "/bench_flood"
 TYPE = "std_msgs/msg/String"
 PREFIX = "hello "
-LOCKS = Path("/tmp/rosl-test-domains")  # the test suite's domain locks: hold ours while we run
 MODES = ["strangers", "fragments", "fragments-tiny", "senders", "replays", "jumps", "jumps-near",
          "jumps-future"]  # fmt: skip
 MIB = 1024 * 1024
@@ -509,18 +507,6 @@ def table(head: list[str], rows: list[list[str]]) -> None:
                         enumerate(zip(r, widths, strict=True))), flush=True)  # fmt: skip
 
 
-def lock_domain() -> IO[str]:
-    """Hold the test suite's lock of our domain, so no test picks it while we flood it."""
-    LOCKS.mkdir(exist_ok=True)
-    handle = (LOCKS / f"{DOMAIN}.lock").open("w")
-    try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        handle.close()
-        raise SystemExit(f"domain {DOMAIN} is in use (set ROSL_BENCH_DOMAIN)") from None
-    return handle
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="flood length per mode")
@@ -530,7 +516,7 @@ def main() -> None:
     parser.add_argument("--depth", type=int, default=10, help="the victim's queue depth")
     parser.add_argument("--modes", nargs="+", choices=MODES, default=MODES)
     args = parser.parse_args()
-    lock = lock_domain()
+    lock = lock_domain(DOMAIN)
     folder = Path(tempfile.mkdtemp(prefix="rosl-flood-"))
     forge = Forge(DOMAIN)
     forge.talker_hz = args.talker_hz

@@ -15,11 +15,12 @@ made-up senders costs at most the budget, and only for a second.
 from __future__ import annotations
 
 import mmap
-import os
 import sys
 import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+from rosl.bus.settings import env_number
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -35,12 +36,7 @@ MAX_AGE_NS = 1_000_000_000
 
 def budget_from_env() -> int:
     """The reassembly budget in bytes (``ROSL_REASSEMBLY_MB``; a bad value: the default)."""
-    text = os.environ.get("ROSL_REASSEMBLY_MB", "").strip()
-    try:
-        megabytes = float(text) if text else BUDGET_MB
-    except ValueError:
-        megabytes = BUDGET_MB
-    return int(max(1.0, megabytes) * 1024 * 1024)
+    return int(max(1.0, env_number("ROSL_REASSEMBLY_MB", BUDGET_MB)) * 1024 * 1024)
 
 
 def split(

@@ -18,7 +18,7 @@ from rosl.bus.pacing import pacer_from_env
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
@@ -126,8 +126,17 @@ class InProcessReceiver:
         with self._ready:
             self._queues.pop(channel, None)
 
-    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
-        """Wait for queued datagrams (or a wake-up) and append complete messages to ``out``."""
+    def poll(
+        self,
+        timeout: float | None,
+        out: list[Delivery],
+        channel: int | None = None,
+        limits: Mapping[int, int] | None = None,
+    ) -> int:
+        """Wait for queued datagrams (or a wake-up) and append complete messages to ``out``.
+
+        ``limits`` is not used: what arrived is queued in this process already.
+        """
         with self._ready:
             if self._closed:
                 return 0

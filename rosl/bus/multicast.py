@@ -24,11 +24,12 @@ from rosl.bus import auth as keys
 from rosl.bus import shm as shared
 from rosl.bus.errors import BusError
 from rosl.bus.pacing import pacer_from_env
+from rosl.bus.settings import env_number
 from rosl.bus.transport import CHANNELS
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
@@ -41,6 +42,7 @@ MAX_DOMAIN = 232
 RCVBUF_WANTED = 8 * 1024 * 1024
 RCVBUF_WARN_BELOW = 1024 * 1024
 DRAIN_LIMIT = 1024  # datagrams read from one socket per poll
+BACKLOG_MS = 500  # a message that waited this long in a socket: the rest is read at once
 IP_MULTICAST_ALL = 49  # linux/in.h; not exported by the socket module
 LOOPBACK = "127.0.0.1"
 FIX_HINT = (
@@ -182,6 +184,11 @@ def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
     return sock
 
 
+def backlog_from_env() -> int:
+    """How long (ns) messages may wait in a socket for a queue: ``ROSL_BACKLOG_MS`` or default."""
+    return int(max(0.0, env_number("ROSL_BACKLOG_MS", BACKLOG_MS)) * 1_000_000)
+
+
 def _check_rcvbuf(sock: socket.socket) -> None:
     global _warned_rcvbuf
     granted = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF) // 2  # linux reports double
@@ -287,6 +294,8 @@ class MulticastReceiver:
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
         self._closed = False
+        self.backlog_ns = backlog_from_env()
+        self._caught_up: dict[int, int] = {}  # socket fd -> when stale messages were skipped
 
     def join(self, channel: int) -> None:
         """Open the channel's socket (joining its group) unless it is open."""
@@ -298,11 +307,22 @@ class MulticastReceiver:
         """Close the channel's socket (leaving its group)."""
         with self._lock:
             sock = self._sockets.pop(channel, None)
+            if sock is not None:
+                self._caught_up.pop(sock.fileno(), None)
         if sock is not None:
             sock.close()
 
-    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
-        """Wait for datagrams (or a wake-up) and append the complete messages to ``out``."""
+    def poll(
+        self,
+        timeout: float | None,
+        out: list[Delivery],
+        channel: int | None = None,
+        limits: Mapping[int, int] | None = None,
+    ) -> int:
+        """Wait for datagrams (or a wake-up) and append the complete messages to ``out``.
+
+        ``limits`` bounds what is read per channel (see :meth:`_drain`).
+        """
         with self._lock:
             if self._closed:
                 return 0
@@ -311,6 +331,7 @@ class MulticastReceiver:
             else:
                 sock = self._sockets.get(channel)
                 watched = [] if sock is None else [sock]
+            channels = {id(sock): number for number, sock in self._sockets.items()}
         if not watched:
             return 0
         try:
@@ -320,18 +341,42 @@ class MulticastReceiver:
         except (OSError, ValueError):
             return 0  # a socket closed under us (shutdown)
         drained = 0
-        drain = self.reader.drain
         for item in ready:
             if isinstance(item, socket.socket):
                 drained += 1
-                # bounded: a sender faster than we parse must not grow ``out`` without end;
-                # what is left stays in the socket for the next poll
-                drain(item.recv, out, DRAIN_LIMIT)
+                limit = None if limits is None else limits.get(channels.get(id(item), -1))
+                self._drain(item, out, limit)
             else:
                 with contextlib.suppress(OSError):
                     while os.read(self._wake_read, 4096):
                         pass
         return drained
+
+    def _drain(self, sock: socket.socket, out: list[Delivery], limit: int | None) -> None:
+        """Read one socket's datagrams: up to ``limit``, unless those waiting are stale.
+
+        Always bounded (:data:`DRAIN_LIMIT`): a sender faster than we parse must not grow
+        ``out`` without end; what is left stays in the socket for the next poll. With a
+        ``limit`` (the depth of the queues the channel's messages go to), no more is read
+        than they hold: the kernel's receive buffer, megabytes deep, absorbs a burst of many
+        publishers that a 10-deep queue would lose. But when the last message read waited in
+        the socket longer than :data:`BACKLOG_MS` (``ROSL_BACKLOG_MS``), the rest is read at
+        once and keep-last queues keep the newest: a callback slower than its publishers
+        gets fresh messages, not ones that waited seconds in the kernel. At most once per
+        bound per socket: a process that cannot keep up at all must not spend its time
+        reading messages only to push them out of a queue again.
+        """
+        if limit is None or limit >= DRAIN_LIMIT:
+            self.reader.drain(sock.recv, out, DRAIN_LIMIT)
+            return
+        start = len(out)
+        if self.reader.drain(sock.recv, out, max(1, limit)) and len(out) > start:
+            last = out[-1]
+            stale = last.received - last.stamp > self.backlog_ns  # (the sender's stamp)
+            key = sock.fileno()
+            if stale and last.received - self._caught_up.get(key, 0) > self.backlog_ns:
+                self._caught_up[key] = last.received
+                self.reader.drain(sock.recv, out, DRAIN_LIMIT)
 
     def wake(self) -> None:
         """Wake a thread blocked in :meth:`poll`."""

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Protocol
 from rosl.bus.errors import BusError
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.pacing import Pacer
@@ -48,13 +48,23 @@ class Receiver(Protocol):
     def leave(self, channel: int) -> None:
         """Stop receiving ``channel`` (idempotent)."""
 
-    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
+    def poll(
+        self,
+        timeout: float | None,
+        out: list[Delivery],
+        channel: int | None = None,
+        limits: Mapping[int, int] | None = None,
+    ) -> int:
         """Wait up to ``timeout`` seconds, then append every complete message to ``out``.
 
         Args:
             timeout: seconds to wait for a first datagram (None: until one or a wake-up).
             out: receives the deliveries, in arrival order per channel.
             channel: read only this channel, and do not take wake-ups (a nested wait).
+            limits: per channel, about how many datagrams one poll should take (the room in
+                the queues they go to); the rest waits in the transport's own buffer, unless
+                it has waited too long (see :mod:`rosl.bus.multicast`). A receiver whose
+                messages are queued elsewhere anyway may ignore it.
 
         Returns:
             How many channels had datagrams (callers sort across channels when > 1).

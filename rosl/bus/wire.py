@@ -692,6 +692,15 @@ class Reader:
         """Messages received on all publisher streams, or on one topic's."""
         return self._count(0, topic)
 
+    def lost_by_publisher(self, topic: int) -> dict[tuple[int, int], int]:
+        """Messages lost (sequence gaps) per publisher (process, endpoint) followed on a topic.
+
+        Only publishers with loss; retired streams are in :meth:`lost` only.
+        """
+        with self._lock:
+            live = tuple(self.streams.items())
+        return {key: s.lost for key, s in live if s.topic == topic and s.lost}
+
     def _count(self, field: int, topic: int | None) -> int:
         # snapshots: the polling thread adds and retires streams while other threads count
         with self._lock:

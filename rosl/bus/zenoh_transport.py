@@ -38,7 +38,7 @@ from rosl.bus.transport import channel_of
 from rosl.bus.wire import Delivery, Reader, StreamStats
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     import zenoh
 
@@ -472,8 +472,17 @@ class ZenohReceiver:
             self._queue.append(item)
             self._ready.notify_all()
 
-    def poll(self, timeout: float | None, out: list[Delivery], channel: int | None = None) -> int:
-        """Wait for queued messages (or a wake-up) and append them to ``out``."""
+    def poll(
+        self,
+        timeout: float | None,
+        out: list[Delivery],
+        channel: int | None = None,
+        limits: Mapping[int, int] | None = None,
+    ) -> int:
+        """Wait for queued messages (or a wake-up) and append them to ``out``.
+
+        ``limits`` is not used: what arrived is queued in this process already.
+        """
         with self._ready:
             if self._closed:
                 return 0

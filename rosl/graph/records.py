@@ -22,7 +22,8 @@ class EndpointRecord:
         type: the canonical type name.
         endpoint: the endpoint's number within its process.
         qos: QoS words (reliability, durability, history, depth, ...).
-        stats: counters: ``sent`` for writers; ``received`` and ``lost`` for readers.
+        stats: counters: ``sent`` for writers; ``received``, ``lost`` and ``dropped`` for
+            readers, and ``lost from <gid>`` per publisher with loss.
         digest: a fingerprint of the type's definition as the endpoint's process reads it
             (empty when unknown): two endpoints of one type name may still disagree on fields.
     """
@@ -69,6 +70,9 @@ class ProcessRecord:
     seen: float = 0.0  # time.monotonic() of the last announcement
     lockstep: bool = False  # spins an executor that answers a lock-stepped simulator
     shm: str = ""  # where it maps shared memory (``bus.shm.host_identity``); "": it does not
+
+
+LOST_FROM = "lost from "  # a reader's stats key prefix: messages lost from the publisher (gid)
 
 
 def gid(process: int, endpoint: int) -> str:

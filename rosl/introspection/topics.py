@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from rosl.graph.records import PUBLISHER, SUBSCRIPTION, gid
+from rosl.graph.records import LOST_FROM, PUBLISHER, SUBSCRIPTION, gid
 from rosl.introspection.session import sorted_endpoints, visible
 
 if TYPE_CHECKING:
@@ -134,10 +134,24 @@ def _endpoint_block(
         return "\n".join(lines)
     counts = endpoint.stats
     if endpoint.kind == PUBLISHER:
-        lines.append(f"Messages sent: {counts.get('sent', 0)}")
+        key = LOST_FROM + gid(node.process, endpoint.endpoint)
+        lost = sum(other.stats.get(key, 0) for _, other in others)
+        lines.append(f"Messages sent: {counts.get('sent', 0)} (lost on the way: {lost})")
     else:
         lines.append(
-            f"Messages received: {counts.get('received', 0)} "
-            f"(lost: {counts.get('lost', 0)}, wrong type: {counts.get('mismatched', 0)})"
+            f"Messages received: {counts.get('received', 0)} (lost: {counts.get('lost', 0)}, "
+            f"dropped: {counts.get('dropped', 0)}, wrong type: {counts.get('mismatched', 0)})"
         )
+        lines += _lost_from(counts, others)
     return "\n".join(lines)
+
+
+def _lost_from(
+    counts: dict[str, int], publishers: list[tuple[NodeRecord, EndpointRecord]]
+) -> list[str]:
+    """A line per publisher this subscription lost messages from (sequence gaps)."""
+    names = {gid(node.process, e.endpoint): node.fqn for node, e in publishers}
+    found = [
+        (key.removeprefix(LOST_FROM), n) for key, n in counts.items() if key.startswith(LOST_FROM)
+    ]
+    return [f"  Lost from {names.get(source, source)}: {count}" for source, count in found]

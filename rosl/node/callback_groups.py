@@ -165,6 +165,11 @@ class Queued(Executable):
     def _ready(self) -> bool:
         return bool(self._queue)
 
+    @property
+    def queue_limit(self) -> int | None:
+        """How many deliveries its queue holds before the oldest goes (None: no bound)."""
+        return self._queue.maxlen
+
     def _pop(self) -> Delivery | None:
         """The oldest queued delivery (None: another thread took it)."""
         try:

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Protocol, cast
 from rosl.bus.header import topic_hash
 from rosl.bus.transport import CHANNELS, channel_of, open_transport
 from rosl.graph.announce import Discovery
+from rosl.node.callback_groups import Queued
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -58,6 +59,7 @@ class Participant:
         self._node_ids = itertools.count(1)
         self._describers: dict[int, Callable[[], NodeRecord]] = {}
         self._handlers: dict[int, list[Handler]] = {}
+        self._limits: dict[int, int] = {}  # channel -> datagrams one poll reads (see listen)
         self._lock = threading.RLock()
         # executors waiting for work; reentrant: a signal handler may notify() while the
         # thread it interrupted holds it
@@ -158,6 +160,7 @@ class Participant:
         with self._lock:
             self._handlers.setdefault(topic, []).append(handler)
             self.reader.wanted.add(topic)
+            self._limit_reads()
         self._receiver.join(channel_of(topic))
         self.notify()
 
@@ -171,6 +174,26 @@ class Participant:
                 self._handlers.pop(topic, None)
                 if not self.reader.want_all:
                     self.reader.wanted.discard(topic)
+            self._limit_reads()
+
+    def _limit_reads(self) -> None:
+        """Per channel, the shallowest queue its messages go to: what one poll should read.
+
+        Reading more than a keep-last queue holds would push messages out of it that the
+        socket's buffer could have kept until the executor got to them (many publishers
+        into one subscriber). A channel with a tap (a monitor, a recorder) is not limited.
+        """
+        limits: dict[int, int] = {}
+        unlimited = set(range(CHANNELS + 1)) if self.reader.want_all else set()
+        for topic, handlers in self._handlers.items():
+            channel = channel_of(topic)
+            for handler in handlers:
+                depth = handler.queue_limit if isinstance(handler, Queued) else None
+                if depth is None:
+                    unlimited.add(channel)
+                else:
+                    limits[channel] = min(depth, limits.get(channel, depth))
+        self._limits = {c: n for c, n in limits.items() if c not in unlimited}
 
     def listen_all(self) -> None:
         """Receive every topic on every channel (for recorders and monitors)."""
@@ -179,6 +202,7 @@ class Participant:
         with self._lock:
             self.reader.want_all = True
             self.reader.ignored.add(topic_hash(LOCKSTEP_TOPIC))  # lock-step answers: control only
+            self._limit_reads()
         for channel in range(1, CHANNELS + 1):
             self._receiver.join(channel)
         self.notify()
@@ -274,7 +298,8 @@ class Participant:
 
     def _poll_locked(self, timeout: float | None, sink: Callable[[Delivery], None] | None) -> int:
         deliveries: list[Delivery] = []
-        channels = self._receiver.poll(timeout, deliveries)
+        limits = self._limits if sink is None else None  # a sink takes everything at once
+        channels = self._receiver.poll(timeout, deliveries, None, limits)
         if channels > 1:
             deliveries.sort(key=_send_order)  # in the order they were sent, across channels
         for delivery in deliveries:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Flags, Kind, topic_hash, type_hash
-from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
+from rosl.graph.records import LOST_FROM, PUBLISHER, SUBSCRIPTION, EndpointRecord, gid
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
 from rosl.node.callback_groups import Queued, held_here, holding
@@ -41,6 +41,7 @@ _LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
 KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
 MAX_PEERS = 4096  # publishers a subscription remembers what the graph said of
+MAX_LOSS_SOURCES = 16  # publishers whose loss a subscription's record names (the worst first)
 
 
 def queue_depth(qos: QoSProfile) -> int:
@@ -317,13 +318,20 @@ class Subscription(Queued):
         """Messages lost on this topic (sequence gaps seen by this process)."""
         return self.node.participant.reader.lost(self._topic_hash)
 
+    def lost_by_publisher(self) -> dict[tuple[int, int], int]:
+        """Messages lost on this topic per publisher (process, endpoint), where any were."""
+        return self.node.participant.reader.lost_by_publisher(self._topic_hash)
+
     def record(self) -> EndpointRecord:
-        """This subscription as discovery announces it."""
+        """This subscription as discovery announces it (with the loss of the worst publishers)."""
+        stats = {"received": self.received, "lost": self.lost, "dropped": self.dropped,
+                 "mismatched": self.mismatched, "incompatible": self.incompatible,
+                 "expired": self.expired}  # fmt: skip
+        worst = sorted(self.lost_by_publisher().items(), key=lambda item: -item[1])
+        for (process, endpoint), lost in worst[:MAX_LOSS_SOURCES]:
+            stats[f"{LOST_FROM}{gid(process, endpoint)}"] = lost
         return EndpointRecord(
-            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self._words,
-            {"received": self.received, "lost": self.lost, "dropped": self.dropped,
-             "mismatched": self.mismatched, "incompatible": self.incompatible,
-             "expired": self.expired},
+            SUBSCRIPTION, self.topic, self.type_name, self.endpoint, self._words, stats,
             self.digest,
         )  # fmt: skip
 

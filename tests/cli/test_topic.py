@@ -135,7 +135,8 @@ def test_info_prints_the_type_and_counts_and_with_v_one_block_per_endpoint(
     # rosl's counters only on request
     stats = run(processes, "topic", "info", "/pub_in", "-v", "--stats")
     assert stats.out.endswith(
-        "  Liveliness lease duration: Infinite\nMessages received: 0 (lost: 0, wrong type: 0)\n\n"
+        "  Liveliness lease duration: Infinite\n"
+        "Messages received: 0 (lost: 0, dropped: 0, wrong type: 0)\n\n"
     )
 
 
