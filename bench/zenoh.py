@@ -4,7 +4,8 @@ Throughput: one publisher process, one subscriber process, the publisher flat ou
 pre-serialized std_msgs/msg/UInt8MultiArray payloads of 64 B, 1 KB, 60 KB and 1 MiB; the
 subscriber counts what arrives between its first and last message. Latency: ping-pong over
 two topics between two processes (median round trip of 64 B). Three contenders, measured in
-the same run: plain zenoh (puts with rmw_zenoh's 33-byte attachment, a callback), rosl with
+the same run: plain zenoh (puts with rmw_zenoh's 33-byte attachment, a callback that takes
+the payload's bytes into Python, as rosl's raw subscriptions get them), rosl with
 ``ROSL_TRANSPORT=zenoh`` (publishers, subscriptions, spin), and rosl's multicast bus. All
 Zenoh sessions connect to a router this script starts on a free loopback port.
 
@@ -66,8 +67,10 @@ def sub(kind: str, port: int, count: int) -> None:
     """Count ``count`` messages (or until 3 s of silence); print 'got seconds'."""
     got, first, last = 0, 0.0, 0.0
 
-    def take(_: object) -> None:
+    def take(data: object) -> None:
         nonlocal got, first, last
+        if kind == "zenoh":
+            data.payload.to_bytes()  # type: ignore[attr-defined]  # as rosl: the bytes in Python
         last = time.perf_counter()
         if not got:
             first = last

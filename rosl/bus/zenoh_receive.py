@@ -178,6 +178,8 @@ class ZenohReceiver:
             except queue.Empty:
                 return items
             if item is _WAKE:
+                if self._closed:
+                    return []
                 if wakes:
                     self._woken = False
                     deadline = time.monotonic()  # take what is queued, wait no longer
