@@ -276,6 +276,11 @@ def _one(kind: str, port: int, size: int, count: int) -> float:
     return float(out.split()[-1])
 
 
+def _ratio(value: float, baseline: float) -> str:
+    """``value / baseline`` as ``0.42x``; a dash when the baseline dropped (nearly) all."""
+    return f"{value / baseline:>8.2f}x" if baseline > 0 else f"{'-':>9}"
+
+
 def _report(port: int, count: int, rounds: int) -> None:
     kinds = ["zenoh", "rosl-zenoh", "rosl-multicast"]
     print(
@@ -287,11 +292,11 @@ def _report(port: int, count: int, rounds: int) -> None:
         n = count if size < 60000 else max(200, count // 10 if size < 1 << 20 else count // 50)
         rates = [_one(kind, port, size, n) for kind in kinds]
         print(f"{size:>8} " + " ".join(f"{r:>15.0f}" for r in rates)
-              + f"  {rates[1] / max(rates[0], 1e-9):>8.2f}x")  # fmt: skip
+              + f"  {_ratio(rates[1], rates[0])}")  # fmt: skip
     print(f"round trip, 64 B, median us ({rounds} rounds)")
     lat = [_one(kind, port, 0, rounds) for kind in kinds]
     print("         " + " ".join(f"{v:>15.0f}" for v in lat)
-          + f"  {lat[1] / max(lat[0], 1e-9):>8.2f}x")  # fmt: skip
+          + f"  {_ratio(lat[1], lat[0])}")  # fmt: skip
 
 
 if __name__ == "__main__":
