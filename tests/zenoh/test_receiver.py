@@ -129,3 +129,27 @@ def test_a_sample_with_a_malformed_attachment_is_dropped(transport: ZenohTranspo
     receiver.poll(0.3, got)
     assert [bytes(d.payload) for d in got] == [_string("fine")]
     assert got[0].seq == 7
+
+
+def test_a_raw_subscription_gets_each_message_as_the_bytes_that_were_sent(
+    router: Router, ros: object
+) -> None:
+    from std_msgs.msg import String
+
+    import rosl
+    from tests.conftest import wait_until
+
+    node = rosl.create_node("raw_listener")
+    heard: list[object] = []
+    node.create_subscription(String, "/raw", heard.append, 10, raw=True)
+    publisher = node.create_publisher(String, "/raw", 10)
+    big = "x" * 200_000  # a large message: the received bytes object is passed on
+
+    def exchanged() -> bool:
+        publisher.publish(String(data=big))
+        rosl.spin_once(node, timeout_sec=0.1)
+        return bool(heard)
+
+    assert wait_until(exchanged, BOUND)
+    assert type(heard[0]) is bytes
+    assert heard[0] == _string(big)
