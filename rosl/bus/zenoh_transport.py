@@ -14,7 +14,9 @@ Datagrams from the layers above are read here and mapped onto Zenoh as a ROS 2 n
   announced to the local graph by :class:`rosl.bus.zenoh_graph.ForeignGraph`.
 
 Received messages become :class:`~rosl.bus.wire.Delivery` records at once (Zenoh reassembles
-and orders); the receivers' readers keep filtering by topic and counting per publisher.
+and orders; see :mod:`rosl.bus.zenoh_receive`); the receivers' readers keep filtering by topic
+and counting per publisher. A publisher's plain message skips rosl's header altogether: its
+writer calls the put that :meth:`ZenohTransport.direct_sender` made for it.
 """
 
 from __future__ import annotations
