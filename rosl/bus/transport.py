@@ -13,9 +13,12 @@ and :class:`rosl.bus.inprocess.InProcessTransport` (one process, for tests of th
 :class:`rosl.bus.zenoh_transport.ZenohTransport` (Zenoh in rmw_zenoh's wire format: ROS 2
 nodes, other hosts). The environment variable ``ROSL_TRANSPORT`` picks one (``multicast``,
 ``inprocess``, ``zenoh``). A transport may also have ``register_writer(topic, name, type,
-kind)``, called for every new writer: the Zenoh transport learns its key expression there,
-and ``shm`` (a :class:`rosl.bus.shm.SharedMemory`, or None): the multicast transport's rings
-for large messages between processes of one host (writers opt in with ``use_shm``).
+kind)``, called for every new writer: the Zenoh transport learns its key expression there;
+and ``direct_sender(topic, sender, endpoint, kind)``, which may return a function
+``(payload, seq, stamp)`` that a writer of an unsigned transport calls for its plain messages
+instead of making a datagram (the Zenoh transport's puts); and ``shm`` (a
+:class:`rosl.bus.shm.SharedMemory`, or None): the multicast transport's rings for large
+messages between processes of one host (writers opt in with ``use_shm``).
 """
 
 from __future__ import annotations

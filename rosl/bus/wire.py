@@ -228,6 +228,11 @@ class Writer:
         register = getattr(transport, "register_writer", None)
         if register is not None:  # a transport that routes by name (Zenoh)
             register(self.topic, name, type_name, int(kind))
+        # a transport's short way for plain messages, with no rosl header (Zenoh's puts)
+        self._direct: Callable[[Buffer, int, int], None] | None = None
+        direct = getattr(transport, "direct_sender", None)
+        if direct is not None and self.auth is None:
+            self._direct = direct(self.topic, sender, endpoint, int(kind))
 
     def coalesce(self, flusher: Flusher, limit: int) -> None:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
@@ -288,6 +293,13 @@ class Writer:
         """
         number = (next(self._seq) if seq is None else seq) & 0xFFFFFFFF
         flags = self.flags
+        direct = self._direct
+        if direct is not None and kind is None and address is None and not (flags or self.batch):
+            direct(payload, number, time.time_ns() if stamp is None else stamp)
+            self.sent += 1
+            if seq is None:
+                self.last_seq = number
+            return number
         if address is not None:
             payload = ADDRESS.pack(*address) + bytes(payload)
             flags |= _ADDRESSED

@@ -14,12 +14,13 @@ Datagrams from the layers above are read here and mapped onto Zenoh as a ROS 2 n
   announced to the local graph by :class:`rosl.bus.zenoh_graph.ForeignGraph`.
 
 Received messages become :class:`~rosl.bus.wire.Delivery` records at once (Zenoh reassembles
-and orders); the receivers' readers keep filtering by topic and counting per publisher.
+and orders; see :mod:`rosl.bus.zenoh_receive`); the receivers' readers keep filtering by topic
+and counting per publisher. A publisher's plain message skips rosl's header altogether: its
+writer calls the put that :meth:`ZenohTransport.direct_sender` made for it.
 """
 
 from __future__ import annotations
 
-import collections
 import contextlib
 import json
 import threading
@@ -35,10 +36,11 @@ from rosl.bus.header import topic_hash as hash_topic
 from rosl.bus.header import type_hash as hash_type
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.transport import channel_of
-from rosl.bus.wire import Delivery, Reader, StreamStats
+from rosl.bus.wire import Delivery
+from rosl.bus.zenoh_receive import ZenohReceiver, read_attachment, sample_callback
 
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Sequence
 
     import zenoh
 
@@ -48,7 +50,6 @@ if TYPE_CHECKING:
 MAX_DATAGRAM = 1 << 30  # Zenoh fragments and reassembles: rosl never splits a message
 ROSL_PREFIX = "@rosl"
 SETTLE_S = 2.0  # the longest a new session waits for links to the sessions in the graph
-QUEUE_LIMIT = 65536  # deliveries a receiver holds before new ones are dropped
 
 
 @dataclass(slots=True)
@@ -98,7 +99,7 @@ class ZenohTransport:
         self.session: zenoh.Session = open_session(session_config())
         self.zid = str(self.session.info.zid())
         self._lock = threading.RLock()
-        self._receivers: list[ZenohReceiver] = []
+        self.receivers: tuple[ZenohReceiver, ...] = ()  # replaced whole: read without a lock
         self._routes: dict[int, _Route] = {}  # topic/service hash -> route
         self._publishers: dict[str, Any] = {}  # key -> zenoh.Publisher
         self._queryables: dict[str, Any] = {}
@@ -166,7 +167,9 @@ class ZenohTransport:
         """Declare a Zenoh subscriber on a data key (idempotent)."""
         with self._lock:
             if key not in self._subscribers and not self._closed:
-                self._subscribers[key] = self.session.declare_subscriber(key, self._on_sample)
+                self._subscribers[key] = self.session.declare_subscriber(
+                    key, sample_callback(self, self.key_hashes(key))
+                )
 
     def unsubscribe(self, key: str) -> None:
         """Undeclare a data key's subscriber."""
@@ -180,7 +183,7 @@ class ZenohTransport:
         with self._lock:
             if self._wildcard is None and not self._closed:
                 self._wildcard = self.session.declare_subscriber(
-                    f"{self.domain}/**", self._on_sample
+                    f"{self.domain}/**", sample_callback(self, None)
                 )
 
     # --- sending --------------------------------------------------------------------------------
@@ -219,6 +222,10 @@ class ZenohTransport:
                 raise BusError(f"Zenoh: cannot send: {err}") from None
 
     def _put(self, key: str, payload: Buffer, attachment: bytes) -> None:
+        self._publisher(key).put(bytes(payload), attachment=attachment)
+
+    def _publisher(self, key: str) -> Any:
+        """The declared publisher of a data key (declared at its first message)."""
         publisher = self._publishers.get(key)
         if publisher is None:
             with self._lock:
@@ -226,7 +233,31 @@ class ZenohTransport:
                 if publisher is None:
                     publisher = self.session.declare_publisher(key)
                     self._publishers[key] = publisher
-        publisher.put(bytes(payload), attachment=attachment)
+        return publisher
+
+    def direct_sender(
+        self, topic: int, sender: int, endpoint: int, kind: int
+    ) -> Callable[[Buffer, int, int], None] | None:
+        """A writer's short way for plain messages (the seam's optional hook), or None.
+
+        A publisher's message becomes a put on its topic's key with no rosl header made and
+        read back: ``put(payload, seq, stamp)``. Other kinds, and topics without a key here,
+        go through :meth:`send`.
+        """
+        route = self._routes.get(topic)
+        if kind != Kind.DATA or route is None or not route.key or route.service:
+            return None
+        key, gid, pack = route.key, self.local.gid, wire.ATTACHMENT.pack
+        size = wire.GID_SIZE
+
+        def put(payload: Buffer, seq: int, stamp: int) -> None:
+            if self._closed:
+                return
+            data = payload if type(payload) is bytes else bytes(payload)
+            attachment = pack(seq, stamp, size, gid(sender, endpoint))
+            self._publisher(key).put(data, attachment=attachment)
+
+        return put
 
     def _request(
         self, route: _Route, sender: int, endpoint: int, seq: int, stamp: int, payload: Buffer
@@ -304,12 +335,11 @@ class ZenohTransport:
 
     def inject(self, channel: int, datagram: bytes) -> None:
         """Hand a rosl datagram to every receiver that joined ``channel``."""
-        with self._lock:
-            receivers = [r for r in self._receivers if channel in r.channels]
-        for receiver in receivers:
-            receiver.put_datagram(datagram)
+        for receiver in self.receivers:
+            if channel in receiver.channels:
+                receiver.put_datagram(datagram)
 
-    def _hashes(self, keyexpr: str) -> tuple[int, int]:
+    def key_hashes(self, keyexpr: str) -> tuple[int, int]:
         """Rosl's (topic, type) hashes of a data key (cached: computed once per key)."""
         hashes = self._key_hashes.get(keyexpr)
         if hashes is None:
@@ -319,44 +349,18 @@ class ZenohTransport:
                 self._key_hashes[keyexpr] = hashes
         return hashes
 
-    def _on_sample(self, sample: zenoh.Sample) -> None:
-        try:
-            topic, type_ = self._hashes(str(sample.key_expr))
-            attachment = sample.attachment
-            if attachment is None:
-                return  # rmw_zenoh drops samples without one too
-            seq, stamp, gid = wire.decode_attachment(attachment.to_bytes())
-        except ValueError:
-            return
-        sender = int.from_bytes(gid[:8], "little") | 1
-        endpoint = int.from_bytes(gid[8:10], "little")
-        payload = sample.payload.to_bytes()
-        self._deliver(
-            Delivery(
-                Kind.DATA,
-                sender,
-                endpoint,
-                seq & 0xFFFFFFFF,
-                topic,
-                type_,
-                stamp,
-                time.time_ns(),
-                memoryview(payload),
-            )
-        )
-
     def _on_query(self, query: zenoh.Query) -> None:
         try:
-            topic, type_ = self._hashes(str(query.key_expr))
+            topic, type_ = self.key_hashes(str(query.key_expr))
             attachment = query.attachment
             if attachment is None:
                 raise ValueError("no attachment")
-            seq, stamp, gid = wire.decode_attachment(attachment.to_bytes())
+            attachment_bytes = attachment.to_bytes()
+            seq, stamp, sender, endpoint = read_attachment(attachment_bytes)
         except ValueError:
             query.reply_err(b"rosl: a request needs rmw_zenoh's attachment")
             return
-        sender = int.from_bytes(gid[:8], "little") | 1
-        endpoint = int.from_bytes(gid[8:10], "little")
+        gid = attachment_bytes[17:]
         seq &= 0xFFFFFFFF
         with self._lock:
             self._queries[(sender, endpoint, seq)] = (query, gid)
@@ -377,10 +381,9 @@ class ZenohTransport:
 
     def _deliver(self, delivery: Delivery) -> None:
         channel = channel_of(delivery.topic)
-        with self._lock:
-            receivers = [r for r in self._receivers if channel in r.channels]
-        for receiver in receivers:
-            receiver.put_delivery(delivery)
+        for receiver in self.receivers:
+            if channel in receiver.channels:
+                receiver.put_delivery(delivery)
 
     # --- the seam -------------------------------------------------------------------------------
 
@@ -388,14 +391,13 @@ class ZenohTransport:
         """A new receiver with no channel joined."""
         receiver = ZenohReceiver(self)
         with self._lock:
-            self._receivers.append(receiver)
+            self.receivers = (*self.receivers, receiver)
         return receiver
 
     def forget(self, receiver: ZenohReceiver) -> None:
         """A receiver closed."""
         with self._lock:
-            if receiver in self._receivers:
-                self._receivers.remove(receiver)
+            self.receivers = tuple(r for r in self.receivers if r is not receiver)
 
     def describe(self) -> str:
         """Where the traffic goes."""
@@ -406,7 +408,7 @@ class ZenohTransport:
         if self._closed:
             return
         self._closed = True
-        for receiver in list(self._receivers):
+        for receiver in self.receivers:
             receiver.close()
         self.foreign.close()
         self.local.update(None)
@@ -424,121 +426,3 @@ def _failure(err: Any) -> bytes:
     if text.startswith("{"):
         return text.encode()  # rosl's own failure payload (JSON)
     return json.dumps({"error": text}).encode()
-
-
-class ZenohReceiver:
-    """Deliveries queued by Zenoh's threads; polled by the layers above."""
-
-    def __init__(self, transport: ZenohTransport) -> None:
-        self.reader = Reader(None)
-        self.channels: set[int] = set()
-        self._transport = transport
-        self._queue: collections.deque[Delivery | bytes] = collections.deque()
-        self._ready = threading.Condition()
-        self._woken = False
-        self._closed = False
-        self.dropped = 0
-
-    def join(self, channel: int) -> None:
-        """Start receiving ``channel`` (every topic when the reader wants all)."""
-        self.channels.add(channel)
-        if channel and self.reader.want_all:
-            self._transport.subscribe_all()
-
-    def leave(self, channel: int) -> None:
-        """Stop receiving ``channel``."""
-        self.channels.discard(channel)
-
-    def put_delivery(self, delivery: Delivery) -> None:
-        """Queue a message for the next poll, when this reader wants its topic."""
-        reader = self.reader
-        if (not reader.want_all and delivery.topic not in reader.wanted) or (
-            delivery.topic in reader.ignored
-        ):
-            return
-        self._put(delivery)
-
-    def put_datagram(self, datagram: bytes) -> None:
-        """Queue a rosl datagram (read by the reader at the next poll)."""
-        self._put(datagram)
-
-    def _put(self, item: Delivery | bytes) -> None:
-        with self._ready:
-            if self._closed:
-                return
-            if len(self._queue) >= QUEUE_LIMIT:
-                self.dropped += 1
-                return
-            self._queue.append(item)
-            self._ready.notify_all()
-
-    def poll(
-        self,
-        timeout: float | None,
-        out: list[Delivery],
-        channel: int | None = None,
-        limits: Mapping[int, int] | None = None,
-    ) -> int:
-        """Wait for queued messages (or a wake-up) and append them to ``out``.
-
-        ``limits`` is not used: what arrived is queued in this process already.
-        """
-        with self._ready:
-            if self._closed:
-                return 0
-            if not self._queue and not (channel is None and self._woken):
-                self._ready.wait(timeout)
-            if channel is None:
-                self._woken = False
-            items = list(self._queue)
-            self._queue.clear()
-        datagrams = []
-        for item in items:
-            if isinstance(item, bytes):
-                datagrams.append(item)
-            else:
-                self._count(item)
-                out.append(item)
-        if datagrams:
-            source = iter(datagrams)
-
-            def recv(size: int) -> bytes:
-                del size
-                try:
-                    return next(source)
-                except StopIteration:
-                    raise BlockingIOError from None
-
-            while self.reader.drain(recv, out):
-                pass
-        return 1 if items else 0
-
-    def _count(self, delivery: Delivery) -> None:
-        """Received and lost counts per publisher, as the reader keeps them for datagrams."""
-        if delivery.kind != Kind.DATA:
-            return
-        key = (delivery.sender, delivery.endpoint)
-        stats = self.reader.streams.get(key)
-        if stats is None:
-            stats = StreamStats(delivery.topic, last_seq=delivery.seq - 1)
-            self.reader.streams[key] = stats
-        gap = delivery.seq - stats.last_seq
-        if 1 < gap <= 1 << 16:
-            stats.lost += gap - 1
-        stats.last_seq = max(stats.last_seq, delivery.seq)
-        stats.received += 1
-        stats.last_received = delivery.received
-
-    def wake(self) -> None:
-        """Make a blocked (or the next) :meth:`poll` return."""
-        with self._ready:
-            self._woken = True
-            self._ready.notify_all()
-
-    def close(self) -> None:
-        """Stop receiving (idempotent)."""
-        with self._ready:
-            self._closed = True
-            self._queue.clear()
-            self._ready.notify_all()
-        self._transport.forget(self)

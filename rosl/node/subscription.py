@@ -247,7 +247,7 @@ class Subscription(Queued):
             if stats is not None and stats.lost and delivery.received >= self._lost_told_at:
                 self._tell_loss(delivery)
         if self.raw:
-            message: Any = bytes(delivery.payload)
+            message: Any = _as_bytes(delivery.payload)
         else:
             try:
                 message = self._store.deserialize(delivery.payload, self.type_name)
@@ -343,3 +343,16 @@ class Subscription(Queued):
     def destroy(self) -> None:
         """Stop receiving (rclpy: node.destroy_subscription)."""
         self.node.destroy_subscription(self)
+
+
+def _as_bytes(payload: Any) -> bytes:
+    """A raw message's bytes, copied only when they are not a whole bytes object already.
+
+    The Zenoh transport's payloads view all of one (no copy of a large message on the polling
+    thread); the multicast bus's view into a receive buffer, which is copied.
+    """
+    if type(payload) is memoryview:
+        whole = payload.obj
+        if type(whole) is bytes and len(whole) == payload.nbytes:
+            return whole
+    return bytes(payload)
