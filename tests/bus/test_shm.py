@@ -175,7 +175,9 @@ def test_a_crashed_publisher_leaves_no_ring_behind_the_next_process(
     )
     line = Lines(sweeper.stdout).wait_line("swept", 30.0)
     assert line is not None, Lines(sweeper.stderr).rest(2.0)
-    assert name in line.split()
+    # any rosl process starting on this machine sweeps (a parallel test's may come first):
+    # the ring is gone once a new process has started, whoever swept it
+    assert name in line.split() or not Path(crashed).exists()
     assert not Path(crashed).exists()
     assert Path(alive).exists()  # a running publisher's ring is left alone
 
