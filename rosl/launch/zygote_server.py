@@ -29,30 +29,61 @@ from typing import Any
 
 from rosl.launch.zygote import die_with_parent
 
-_WARM_TYPES = (  # what every node builds at start (parameters, events, rosout, services)
+_WARM_MODULES = (  # what a node imports (measured: the modules new after rosl.Node(...))
+    "yaml",
+    "rosl",
+    "rosl.bus.multicast",
+    "rosl.bus.pacing",
+    "rosl.executor",
+    "rosl.node.guard_condition",
+    "rosl.node.lockstep",
+    "rosl.node.node",
+    "rosl.node.parameter_services",
+    "rosl.node.participant",
+    "rosl.node.publisher",
+    "rosl.node.qos_compatibility",
+    "rosl.node.qos_events",
+    "rosl.node.qos_overrides",
+    "rosl.node.qos_watch",
+    "rosl.node.service",
+    "rosl.node.subscription",
+    "rosl.node.timer",
+    "rosl.pkg.entry",
+    "rosl.runtime",
+)
+_WARM_TYPES = (  # the messages every node sends: parameter events, rosout
     "rcl_interfaces/msg/ParameterEvent",
     "rcl_interfaces/msg/Log",
-    "rcl_interfaces/msg/SetParametersResult",
     "std_msgs/msg/String",
+)
+_WARM_SERVICES = (  # the parameter services every node serves
+    "rcl_interfaces/srv/DescribeParameters",
+    "rcl_interfaces/srv/GetParameterTypes",
+    "rcl_interfaces/srv/GetParameters",
+    "rcl_interfaces/srv/ListParameters",
+    "rcl_interfaces/srv/SetParameters",
+    "rcl_interfaces/srv/SetParametersAtomically",
 )
 
 
 def _warm() -> None:
     """Import what a node imports; build (and serialize once) the messages every node sends."""
-    import yaml  # noqa: F401
+    import importlib
 
-    import rosl
-    import rosl.executor
-    import rosl.node.node
-    import rosl.node.participant
-    import rosl.pkg.entry
-    import rosl.runtime
-    from rosl.idl.registry import get_message_class, store
+    for name in _WARM_MODULES:
+        importlib.import_module(name)
+    from rosl.compat import install
+    from rosl.idl.registry import get_message_class, get_service_class, store
 
-    rosl.compat.install(force=True)
+    install(force=True)
     for name in _WARM_TYPES:
         with contextlib.suppress(Exception):  # a broken search path: the node will say so
             store().serialize(get_message_class(name)())  # class and serializer made once
+    for name in _WARM_SERVICES:
+        with contextlib.suppress(Exception):
+            service = get_service_class(name)
+            for message in (service.Request(), service.Response()):
+                store().deserialize(store().serialize(message), message.__msgtype__)
 
 
 def threads() -> int:
