@@ -83,7 +83,7 @@ def _warm() -> None:
         with contextlib.suppress(Exception):
             service = get_service_class(name)
             for message in (service.Request(), service.Response()):
-                store().deserialize(store().serialize(message), message.__msgtype__)
+                store().serialize(message)  # not decoded: an array would load numpy (threads)
 
 
 def threads() -> int:
