@@ -127,3 +127,32 @@ def test_a_node_with_parameters_that_talks_and_listens_does_not_load_numpy(
         capture_output=True, text=True, timeout=120, check=True,
     )  # fmt: skip
     assert out.stdout.split() == ["hi", "False"], out.stdout + out.stderr
+
+
+def test_serializers_are_made_on_first_use_and_match_rosbags_own() -> None:
+    from rosbags.typesys.store import Typestore
+
+    from rosl.idl import registry
+
+    store = registry.store()
+    odometry = get_message_class("nav_msgs/msg/Odometry")(child_frame_id="base")
+    odometry.pose.covariance[3] = 2.5
+    data = store.serialize(odometry)
+    lazy = store._typestore
+    made = vars(lazy.get_msgdef("nav_msgs/msg/Odometry"))
+    assert "serialize_cdr_le" in made
+    assert "serialize_ros1" not in made
+    assert "deserialize_cdr_be" not in made
+
+    eager = Typestore()  # rosbags' own: every function made at once
+    eager.fielddefs.update(lazy.fielddefs)
+    eager.types.update(lazy.types)
+    wire = store.deserialize(data, "nav_msgs/msg/Odometry")
+    assert wire == odometry
+    for name in ("serialize_cdr", "serialize_ros1"):
+        extra = {"little_endian": False} if name == "serialize_cdr" else {}
+        ours = bytes(getattr(lazy, name)(odometry, "nav_msgs/msg/Odometry", **extra))
+        theirs = bytes(getattr(eager, name)(odometry, "nav_msgs/msg/Odometry", **extra))
+        assert ours == theirs, name
+    ros1 = lazy.cdr_to_ros1(data, "nav_msgs/msg/Odometry")
+    assert bytes(lazy.ros1_to_cdr(ros1, "nav_msgs/msg/Odometry")) == data
