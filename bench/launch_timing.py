@@ -6,10 +6,11 @@ it wakes on every graph change). Rows, median of --runs runs:
 
   rosl launch           `rosl launch FILE.launch.py`: from Popen until all N nodes are visible;
                         then SIGINT to the launcher until it has exited and every child pid is
-                        gone
+                        gone (every node a fork of the launcher's pre-imported interpreter, the
+                        default)
   rosl launch (xml)     the same N nodes from `FILE.launch.xml` (ROS 2's XML format)
-  launch, zygote        `rosl launch FILE.launch.py` with ROSL_LAUNCH_ZYGOTE=1 (opt-in): every
-                        node a fork of the launcher's pre-imported interpreter
+  launch, fresh         `rosl launch FILE.launch.py` with ROSL_LAUNCH_ZYGOTE=0: every node a
+                        fresh interpreter
   rosl run x N          the baseline: N `python -m rosl run tutorial_pkg my_publisher --ros-args
                         -r __node:=NAME` started in parallel (each execs a second interpreter);
                         stop = SIGINT to each, until all have exited
@@ -101,14 +102,14 @@ class Watcher:
 
 
 def run_launch(
-    watcher: Watcher, folder: Path, names: list[str], xml: bool = False, zygote: bool = False
+    watcher: Watcher, folder: Path, names: list[str], xml: bool = False, fresh: bool = False
 ) -> tuple[float, float]:
     path = write_launch_file(folder, names, xml)
     log = open(folder / "launch.log", "w")  # noqa: SIM115
     pids: list[int] = []
     env = bench_env(DOMAIN)
-    if zygote:
-        env["ROSL_LAUNCH_ZYGOTE"] = "1"
+    if fresh:
+        env["ROSL_LAUNCH_ZYGOTE"] = "0"
     start = time.perf_counter()
     launcher = subprocess.Popen(
         [*rosl_cmd(), "launch", str(path)],
@@ -187,8 +188,8 @@ def main() -> None:
     parser.add_argument("--nodes", type=int, default=10)
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
-    kinds = ("rosl launch", "rosl launch (xml)", "launch, zygote", "rosl run x N", "entry x N")
-    tags = {"rosl launch": "l", "rosl launch (xml)": "x", "launch, zygote": "z",
+    kinds = ("rosl launch", "rosl launch (xml)", "launch, fresh", "rosl run x N", "entry x N")
+    tags = {"rosl launch": "l", "rosl launch (xml)": "x", "launch, fresh": "f",
             "rosl run x N": "r", "entry x N": "e"}  # fmt: skip
     results: dict[str, list[tuple[float, float]]] = {kind: [] for kind in kinds}
     watcher = Watcher()
@@ -201,8 +202,8 @@ def main() -> None:
                     time.sleep(0.5)  # let the previous processes finish exiting
                     if kind.startswith("rosl launch"):
                         measured = run_launch(watcher, folder, names, xml=kind.endswith("(xml)"))
-                    elif kind == "launch, zygote":
-                        measured = run_launch(watcher, folder, names, zygote=True)
+                    elif kind == "launch, fresh":
+                        measured = run_launch(watcher, folder, names, fresh=True)
                     elif kind == "rosl run x N":
                         measured = run_parallel(watcher, run_commands(names), names)
                     else:

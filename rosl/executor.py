@@ -27,7 +27,6 @@ import signal
 import threading
 import time
 from collections import deque
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 from rosl.node.callback_groups import held_groups
@@ -570,6 +569,8 @@ class MultiThreadedExecutor(Executor):
             )
         self.num_threads = num_threads or _default_threads()
         self._rotate = True
+        from concurrent.futures import ThreadPoolExecutor  # (and logging): not for every CLI
+
         self._pool = ThreadPoolExecutor(self.num_threads, thread_name_prefix="rosl-executor")
         self._handlers: list[Task[Any]] = []
         self._handlers_lock = threading.Lock()

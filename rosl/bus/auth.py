@@ -34,7 +34,6 @@ import contextlib
 import hashlib
 import hmac
 import os
-import secrets
 import stat
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -162,6 +161,8 @@ def _read(path: Path, group: bool) -> bytes:
 def _own_secret(path: Path) -> bytes:
     """Read the user's key, creating it (mode 0600) on first use; safe when racing."""
     if not path.exists():
+        import secrets  # once per user: not at every start
+
         try:
             path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
             draft = path.with_name(f".{KEY_FILE}.{os.getpid()}.{secrets.token_hex(4)}")

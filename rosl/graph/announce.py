@@ -91,14 +91,19 @@ class Discovery:
         self.started = time.monotonic()  # when discovery began listening
         self._warned = False
         self._thread = threading.Thread(target=self._run, name="rosl-discovery", daemon=True)
+        self.first_query = 0  # the query sent at start (see start())
 
     # --- lifecycle ---------------------------------------------------------------------------
 
     def start(self) -> None:
-        """Start the thread; the first announcement and a graph query go out at once."""
+        """Start the thread; the first announcement and a graph query go out at once.
+
+        A caller that wants the graph soon waits for :attr:`first_query` rather than asking
+        again: everyone has been answering it since this process started.
+        """
         self._thread.start()
         self.changed()
-        self.query()
+        self.first_query = self.query()
 
     def stop(self) -> None:
         """Say goodbye and stop the thread (idempotent)."""
@@ -136,8 +141,8 @@ class Discovery:
         Args:
             qid: from :meth:`query`.
             timeout: the bound on the whole wait (seconds).
-            quiet: when nobody at all answers, how long after our own query came back to
-                conclude the graph is empty.
+            quiet: when nobody at all answers, how long after our own query came back (and
+                after this call) to conclude the graph is empty.
 
         Returns:
             True when complete, False when the bound was hit (some process did not answer).
@@ -145,8 +150,9 @@ class Discovery:
         Raises:
             BusError: our own query never came back: multicast does not work here.
         """
-        deadline = time.monotonic() + timeout
-        echo_deadline = time.monotonic() + max(timeout, 1.0)
+        called = time.monotonic()  # quiet counts from here too (the query may be older)
+        deadline = called + timeout
+        echo_deadline = called + max(timeout, 1.0)
         while True:
             with self._lock:
                 state = self._queries[qid]
@@ -156,7 +162,7 @@ class Discovery:
             if echoed:
                 if answered and known <= answered:
                     return True
-                if not answered and now - echoed >= quiet:
+                if not answered and now - max(echoed, called) >= quiet:
                     return True
                 if now >= deadline:
                     return False

@@ -12,7 +12,7 @@ when the message is serialized (``store``), where ``check_fields`` names the fie
 
 ``byte`` is as rclpy has it: a ``bytes`` object of length 1 (``bytes([0])``), and a byte array is
 a list of them; both are properties that also take 0..255 (and rosbags' signed int8, which is
-how the CDR serializer reads and writes them: :func:`wire_view`). ``char`` is an int.
+how the CDR serializer reads and writes them: ``wire_view.py``). ``char`` is an int.
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ import array as py_array
 import keyword
 import operator
 from collections.abc import Callable, Mapping
-from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any
 
 from rosl.idl.base import ActionType, Message, ServiceType
@@ -200,6 +199,7 @@ def build_message_class(
     namespace: dict[str, Any] = {"_unknown_fields": _unknown_fields}
     body: dict[str, Any] = {}
     slots: list[str] = []
+    lazy: list[str] = []  # the slots of numeric sequences (None while empty, see sequences.py)
     params: list[str] = []
     lines: list[str] = []
     for index, field in enumerate(spec.fields):
@@ -227,6 +227,8 @@ def build_message_class(
             default = None if field.default is None else list(field.default)
             namespace[f"_d{index}"] = default
             slots.append("_" + attr)
+            if ftype.array is not ArrayKind.FIXED:
+                lazy.append("_" + attr)
             body[attr] = (
                 _array_property("_" + attr, coerce)
                 if ftype.array is ArrayKind.FIXED
@@ -302,6 +304,10 @@ def build_message_class(
             body[f"{field.name.upper()}__DEFAULT"] = default
     body["_has_bytes"] = any(f.type.base == "byte" for f in spec.fields) or any(
         getattr(c, "_has_bytes", False) for c in field_classes.values()
+    )
+    body["_lazy_sequences"] = tuple(lazy)
+    body["_has_sequences"] = bool(lazy) or any(
+        getattr(c, "_has_sequences", False) for c in field_classes.values()
     )
     return type(name.name, (Message,), body)
 
@@ -557,40 +563,6 @@ def check_fields(message: Message, path: str = "") -> None:
                 _check_scalar(ftype.element(), item, f"{where}[{i}]")
         elif not ftype.is_array:
             _check_scalar(ftype, value, where)
-
-
-def wire_view(message: Message) -> Any:
-    """Return ``message`` as rosbags' CDR serializer reads it.
-
-    rosbags holds ``byte`` as a signed int8 and a byte array as an int8 numpy array; messages
-    with no byte field anywhere inside are returned as they are.
-
-    Raises:
-        FieldError: a byte field holds something that is not a byte (named by its path).
-    """
-    if not getattr(message, "_has_bytes", False):
-        return message
-    view = SimpleNamespace()
-    for field, attr, ftype in zip(
-        message._spec.fields, message._fields, message._field_types, strict=True
-    ):
-        value = getattr(message, attr)
-        if ftype.base == "byte":
-            where = f"{message.__msgtype__}.{attr}"
-            if not ftype.is_array:
-                value = int.from_bytes(to_byte(value, where), "little", signed=True)
-            else:
-                try:
-                    joined = b"".join(value)
-                except TypeError:
-                    joined = b""
-                if len(joined) != len(value):  # an item set by hand that is not one byte
-                    joined = b"".join(to_byte(v, f"{where}[{i}]") for i, v in enumerate(value))
-                value = np.frombuffer(joined, dtype=np.int8)
-        elif not ftype.is_primitive:
-            value = [wire_view(v) for v in value] if ftype.is_array else wire_view(value)
-        setattr(view, field.name, value)
-    return view
 
 
 def _check_scalar(ftype: FieldType, value: Any, where: str) -> None:

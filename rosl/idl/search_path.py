@@ -17,7 +17,6 @@ directory and ``ROSL_PACKAGE_PATH``); ``rescan()`` drops the cache.
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -105,6 +104,8 @@ def read_package_name(manifest: Path) -> str:
     Raises:
         InterfaceError: the file is not XML, or has no usable ``<name>``.
     """
+    import xml.etree.ElementTree as ET  # only where a package.xml is read
+
     try:
         root = ET.parse(manifest).getroot()
     except ET.ParseError as err:

@@ -6,6 +6,10 @@ message holds is a :class:`SequenceArray` that remembers its message (weakly), a
 ``extend``, ``insert`` and ``pop`` replace the message's field with the grown or shrunk array
 (checked like any assignment: dtype, range, bound). Iterating or indexing it gives Python
 numbers, and it prints as ``array('i', [0, 1])``, as rclpy's fields do.
+
+A sequence left empty at construction holds nothing until it is first read (then an empty
+array is made): a message whose numeric sequences stay empty (a node's ``ParameterEvent``)
+never loads numpy. The serializer reads such a field as :data:`EMPTY` (see ``wire_view``).
 """
 
 from __future__ import annotations
@@ -32,16 +36,45 @@ def array_types() -> tuple[type, ...]:
     return _ARRAY_TYPES
 
 
+class _EmptySequence:
+    """An empty numeric sequence as rosbags' generated serializer reads it (no numpy needed)."""
+
+    __slots__ = ()
+
+    def __len__(self) -> int:
+        return 0
+
+    def view(self, _dtype: object) -> bytes:
+        return b""
+
+    def byteswap(self) -> _EmptySequence:
+        return self
+
+
+EMPTY = _EmptySequence()
+
+
 def sequence_property(slot: str, attr: str, coerce: Callable[[Any], Any]) -> property:
-    """A numeric sequence field: values are coerced, then held as a :class:`SequenceArray`."""
+    """A numeric sequence field: values are coerced, then held as a :class:`SequenceArray`.
+
+    ``None`` (the default) leaves the slot holding None: empty, with no array made yet.
+    """
 
     def setter(self: Any, value: Any) -> None:
+        if value is None:
+            object.__setattr__(self, slot, None)
+            return
         array = coerce(value).view(_ARRAY_TYPES[1] if _ARRAY_TYPES else array_types()[1])
         array._owner = (weakref.ref(self), attr)
         object.__setattr__(self, slot, array)
 
     def getter(self: Any) -> Any:
         array = getattr(self, slot)
+        if array is None:  # empty since construction: its array is made now
+            array = coerce(None).view(_ARRAY_TYPES[1] if _ARRAY_TYPES else array_types()[1])
+            array._owner = (weakref.ref(self), attr)
+            object.__setattr__(self, slot, array)
+            return array
         owner = array._owner
         if owner is None or owner[0]() is not self:  # a copied message: its own view
             array = array.view(_ARRAY_TYPES[1])  # set before: numpy and the class are loaded

@@ -16,8 +16,11 @@ from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from rosl.idl.errors import FieldError, InterfaceError
-from rosl.idl.messages import DUMMY_FIELD, check_fields, wire_view
+from rosl.idl.lazy_serde import LazyTypestore
+from rosl.idl.lazy_serde import install as serde_without_eager_numpy
+from rosl.idl.messages import DUMMY_FIELD, check_fields
 from rosl.idl.parser import ArrayKind, FieldType
+from rosl.idl.wire_view import wire_view
 
 if TYPE_CHECKING:
     import mmap
@@ -62,7 +65,8 @@ class Store:
     """The process-wide registry of CDR serializers for the types in use."""
 
     def __init__(self) -> None:
-        self._typestore = Typestore()
+        serde_without_eager_numpy()  # before any serializer is generated
+        self._typestore: Typestore = LazyTypestore()
         self._lock = threading.Lock()
         self._checked: set[str] = set()
         self._schemas: dict[tuple[str, str, str], Typestore] = {}  # a recording's definitions

@@ -55,7 +55,9 @@ class Session:
         """The graph after one complete query (bounded by QUERY_TIMEOUT)."""
         if fresh or not self._completed:
             discovery = self.participant.discovery
-            discovery.wait_complete(discovery.query(), timeout=QUERY_TIMEOUT)
+            first = not fresh and discovery.first_query
+            qid = discovery.first_query if first else discovery.query()  # one round trip less
+            discovery.wait_complete(qid, timeout=QUERY_TIMEOUT)
             self._completed = True
         return self.participant.graph
 

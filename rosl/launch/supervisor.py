@@ -113,6 +113,7 @@ class Supervisor:
         self._soon: collections.deque[Callable[[], None]] = collections.deque()  # other threads'
         self._zygote: zygote.Zygote | None = None
         self._zygote_failed = False
+        self._zygote_partial: dict[Any, bytes] = {}
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -204,15 +205,35 @@ class Supervisor:
 
     def prepare_zygote(self) -> None:
         """Start the pre-imported interpreter rosl nodes are forked from (if not yet)."""
-        if self._zygote is None and not self.dry_run and zygote.wanted():
-            self._zygote = zygote.Zygote()
-            # its exit reports wake the loop (data None: not a process's pipe)
+        if (
+            self._zygote is None
+            and not self._zygote_failed
+            and not self.dry_run
+            and zygote.wanted()
+        ):
+            try:
+                self._zygote = zygote.Zygote()
+            except OSError as err:
+                self._zygote_failed = True
+                self.log("WARNING", "launch", f"nodes start in fresh interpreters: {err}")
+                return
+            zygote.become_subreaper()  # should it die, its nodes become ours
+            # its reports wake the loop (data None); its own output is shown prefixed
             self._selector.register(self._zygote.sock, selectors.EVENT_READ, None)
+            for pipe, tag in (
+                (self._zygote.popen.stdout, "out"),
+                (self._zygote.popen.stderr, "err"),
+            ):
+                assert pipe is not None
+                os.set_blocking(pipe.fileno(), False)
+                self._selector.register(pipe, selectors.EVENT_READ, tag)
 
     def _close_zygote(self) -> None:
         if self._zygote is not None:
-            with contextlib.suppress(KeyError, ValueError):
-                self._selector.unregister(self._zygote.sock)
+            for item in (self._zygote.sock, self._zygote.popen.stdout, self._zygote.popen.stderr):
+                with contextlib.suppress(KeyError, ValueError, TypeError):
+                    assert item is not None
+                    self._selector.unregister(item)
             self._zygote.close()
             self._zygote = None
 
@@ -221,13 +242,14 @@ class Supervisor:
         base = None if self._zygote is None else self._zygote.env
         if self._zygote_failed or not zygote.can_fork(spec.cmd, env, base):
             return None
+        self.prepare_zygote()
+        if self._zygote is None:
+            return None
         try:
-            self.prepare_zygote()
-            assert self._zygote is not None
             return self._zygote.spawn(spec.cmd, env, spec.cwd, hold)
-        except OSError:  # no zygote (it failed to start): fresh interpreters from now on
-            self._close_zygote()
+        except OSError as err:  # fresh interpreters from now on; its nodes run on
             self._zygote_failed = True
+            self.log("WARNING", "launch", f"nodes start in fresh interpreters: {err}")
             return None
 
     def wait_for_line(self, label: str, text: str, timeout: float) -> bool:
@@ -295,6 +317,8 @@ class Supervisor:
         """Send ``signum`` to the processes whose action ``matcher`` accepts."""
         for running in self._matching(matcher):
             self.log("INFO", running.label, f"sending signal '{signal.Signals(signum).name}'")
+            if running.popen.poll() is not None:
+                continue  # ended: its pid may be another process's by now
             try:
                 os.killpg(running.popen.pid, signum)
             except (ProcessLookupError, PermissionError):
@@ -382,6 +406,8 @@ class Supervisor:
     def _signal(self, running: Running, signum: int) -> None:
         running.stopping = True
         running.signals.append((time.monotonic(), signum))
+        if running.popen.poll() is not None:
+            return  # ended: its pid may be another process's by now
         try:
             os.killpg(running.popen.pid, signum)
         except (ProcessLookupError, PermissionError):
@@ -539,33 +565,41 @@ class Supervisor:
         )  # fmt: skip
         self._signal(running, following)
 
-    def _read(self, pipe: IO[bytes], running: Running | None) -> None:
+    def _read(self, pipe: IO[bytes], running: Running | str | None) -> None:
         if running is None:  # the zygote reports exits
             if self._zygote is not None:
                 self._zygote.collect()
                 if self._zygote.ended:
                     self._selector.unregister(self._zygote.sock)
             return
+        if isinstance(running, str):  # the zygote's own output
+            self._read_zygote_output(pipe, running)
+            return
+        stderr = pipe is running.popen.stderr
+        for line in self._lines(pipe, running.partial, 2 if stderr else 1):
+            self._route(running, line, stderr)
+
+    def _read_zygote_output(self, pipe: IO[bytes], tag: str) -> None:
+        for line in self._lines(pipe, self._zygote_partial, tag):
+            text = line.decode("utf-8", "replace").rstrip("\r")
+            self.log("ERROR" if tag == "err" else "INFO", "launch.zygote", text)
+
+    def _lines(self, pipe: IO[bytes], partial: dict[Any, bytes], key: object) -> list[bytes]:
+        """The whole lines now readable from ``pipe`` (at its end, the unfinished one too)."""
         try:
             chunk = os.read(pipe.fileno(), 65536)
         except (BlockingIOError, InterruptedError):
-            return
+            return []
         except OSError:
             chunk = b""
-        stderr = pipe is running.popen.stderr
-        key = 2 if stderr else 1
+        data = partial.pop(key, b"") + chunk
         if not chunk:
             self._selector.unregister(pipe)
-            rest = running.partial.pop(key, b"")
-            if rest:
-                self._route(running, rest, stderr)
-            return
-        data = running.partial.pop(key, b"") + chunk
+            return [data] if data else []
         *lines, rest = data.split(b"\n")
         if rest:
-            running.partial[key] = rest
-        for line in lines:
-            self._route(running, line, stderr)
+            partial[key] = rest
+        return lines
 
     def _route(self, running: Running, raw: bytes, stderr: bool) -> None:
         text = raw.decode("utf-8", "replace").rstrip("\r")

@@ -1,20 +1,21 @@
-"""A pre-imported interpreter that ``rosl launch`` forks its Python nodes from.
+"""The launcher's side of the pre-imported interpreter ``rosl launch`` forks its nodes from.
 
 Each ``python -P -m rosl.pkg.entry ...`` node started as a fresh interpreter spends most of
-its start-up importing rosl, numpy and rosbags and building the message classes every node
-uses; ten at once on two cores take over a second. The launcher instead starts one zygote
-(``python -P -m rosl.launch.zygote FD``, single-threaded, its own session) that imports all
-that once and then forks one child per node. Each child is still its own process with the
-node's environment, working folder, stdin/stdout/stderr, session (process group) and
-parent-death signal, SIGINT held as ``interrupts`` holds it for a fresh interpreter, and it
-runs ``rosl.pkg.entry`` and exits through the interpreter's normal exit (atexit handlers, non-
-daemon threads joined).
+its start-up importing rosl and building the message classes every node uses. The launcher
+instead starts one zygote (``zygote_server.py``: single-threaded, its own session, dies with
+the launcher) that does that once and then forks one child per node. Each child is still its
+own process with the node's environment, working folder, stdin/stdout/stderr, session and
+parent-death signal, SIGINT held as ``interrupts`` holds it for a fresh interpreter.
 
-Protocol over a Unix socket pair: the launcher sends one JSON request ``{argv, env, cwd,
-hold}`` with the child's stdout and stderr descriptors attached; the zygote answers ``pid N``
-(or ``error TEXT``), and later ``exit N STATUS`` when it has reaped that child.
-:class:`ZygoteProcess` is the launcher's side: the part of ``subprocess.Popen`` the
-supervisor uses (pid, stdout, stderr, poll, wait, send_signal, returncode).
+A node is forked only where that is the same as starting it afresh (:func:`can_fork`): rosl's
+entry on this interpreter, with the same variables that only take effect when a program
+starts (``PYTHON*``, ``LD_*``, locale, allocator); ``TZ`` and the rest are applied in the
+child. Whenever the zygote cannot serve (not ready in time, more than one thread, no answer)
+the supervisor starts that node, and every later one, afresh; nodes already forked keep
+running under the zygote. Their exits reach the launcher before the zygote may reap them (a
+pid is never signalled after it could be reused), and should the zygote itself die, the
+launcher (a child subreaper) inherits and reaps its nodes, so none is left unsupervised.
+:class:`ZygoteProcess` is the part of ``subprocess.Popen`` the supervisor uses.
 """
 
 from __future__ import annotations
@@ -32,58 +33,69 @@ import time
 from typing import IO, Any
 
 ENTRY = ("-P", "-m", "rosl.pkg.entry")
-SWITCH = "ROSL_LAUNCH_ZYGOTE"  # "1": fork nodes from a pre-imported interpreter (opt-in)
+SWITCH = "ROSL_LAUNCH_ZYGOTE"  # "0": every node in a fresh interpreter
 _PR_SET_PDEATHSIG = 1
-ANSWER_TIMEOUT = 60.0  # its warm-up included, on a loaded machine
-_WARM_TYPES = (  # what every node builds at start (parameters, events, rosout, services)
-    "rcl_interfaces/msg/ParameterEvent",
-    "rcl_interfaces/msg/Log",
-    "rcl_interfaces/msg/SetParametersResult",
-    "std_msgs/msg/String",
-)
+_PR_SET_CHILD_SUBREAPER = 36
+READY_TIMEOUT = 60.0  # its warm-up, on a loaded machine (no node waits on it before it is ready)
+ANSWER_TIMEOUT = 10.0  # a warm zygote answers a fork at once
+# variables read only when a program starts: a node whose value differs starts afresh
+_EXEC_ONLY_PREFIXES = ("PYTHON", "LD_", "LC_", "MALLOC_")
+_EXEC_ONLY_NAMES = frozenset({"LANG", "LANGUAGE", "GLIBC_TUNABLES"})
 
 
-def _python_env(env: dict[str, str]) -> dict[str, str]:
+class ZygoteError(OSError):
+    """The zygote cannot serve this node (it is then started afresh)."""
+
+
+def _exec_only(env: dict[str, str]) -> dict[str, str]:
     """The variables that change how an interpreter starts (PYTHONUNBUFFERED aside)."""
-    return {k: v for k, v in env.items() if k.startswith("PYTHON") and k != "PYTHONUNBUFFERED"}
+    return {
+        key: value
+        for key, value in env.items()
+        if (key.startswith(_EXEC_ONLY_PREFIXES) or key in _EXEC_ONLY_NAMES)
+        and key != "PYTHONUNBUFFERED"
+    }
 
 
 def wanted() -> bool:
-    """Whether nodes are to be forked (only with ``ROSL_LAUNCH_ZYGOTE=1``: opt-in for now)."""
-    return os.environ.get(SWITCH) == "1"
+    """Whether nodes are to be forked (unless ``ROSL_LAUNCH_ZYGOTE=0``)."""
+    return os.environ.get(SWITCH, "1") != "0"
 
 
 def can_fork(cmd: list[str], env: dict[str, str], base: dict[str, str] | None = None) -> bool:
     """Whether a zygote started with ``base`` (default: this environment) can fork ``cmd``.
 
-    That is rosl's entry on this interpreter, with the same PYTHON* variables.
+    That is rosl's entry on this interpreter, with the same start-up-only variables.
     """
     return (
         wanted()
         and len(cmd) > 4
         and cmd[0] == sys.executable
         and tuple(cmd[1:4]) == ENTRY
-        and _python_env(env) == _python_env(dict(os.environ) if base is None else base)
+        and _exec_only(env) == _exec_only(dict(os.environ) if base is None else base)
     )
 
 
-# --- the launcher's side ------------------------------------------------------------------------
-
-
 class Zygote:
-    """The launcher's connection to its zygote (started on first use)."""
+    """The launcher's connection to its zygote."""
 
     def __init__(self) -> None:
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
         self.sock = ours
-        self.ended = False  # it has closed its end (and its children are gone with it)
+        self.ended = False  # it has closed its end
+        self.ready = False  # warmed up
+        self.ready_timeout = READY_TIMEOUT
+        self.answer_timeout = ANSWER_TIMEOUT
+        self.strays: list[int] = []  # forked after the launcher stopped waiting: ended at once
+        self._abandoned = 0  # requests not answered in time
         self._buffer = b""
         self._processes: dict[int, ZygoteProcess] = {}
         self.env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         self.popen = subprocess.Popen(
-            [sys.executable, *ENTRY[:2], "rosl.launch.zygote", str(theirs.fileno())],
-            pass_fds=[theirs.fileno()], stdin=subprocess.DEVNULL, start_new_session=True,
-            env=self.env, preexec_fn=die_with_parent,
+            [sys.executable, *ENTRY[:2], "rosl.launch.zygote_server", str(theirs.fileno())],
+            pass_fds=[theirs.fileno()], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE, start_new_session=True, env=self.env,
+            preexec_fn=die_with_parent,
         )  # fmt: skip
         theirs.close()
 
@@ -91,25 +103,26 @@ class Zygote:
         """Fork ``cmd`` (a rosl entry command line); return its :class:`ZygoteProcess`.
 
         Raises:
-            OSError: the zygote is gone or could not fork.
+            ZygoteError: the zygote is gone, not ready in time, or did not fork (and will not).
         """
+        self._wait(lambda: self.ready, self.ready_timeout, "is not ready")
         out_r, out_w = os.pipe()
         err_r, err_w = os.pipe()
+        answer: list[str] = []
         try:
-            request = {"argv": cmd[4:], "env": env, "cwd": cwd, "hold": hold}
-            socket.send_fds(self.sock, [json.dumps(request).encode() + b"\n"], [out_w, err_w])
-            while True:
-                line = self._line(ANSWER_TIMEOUT)
-                if line is None:
-                    raise OSError("the launch zygote has ended")
-                if not line:
-                    raise OSError("the launch zygote does not answer")
-                word, _, rest = line.partition(" ")
-                if word == "pid":
-                    break
-                if word == "error":
-                    raise OSError(rest)
-                self._exited(rest)
+            request = {"op": "spawn", "argv": cmd[4:], "env": env, "cwd": cwd, "hold": hold}
+            self._send(request, [out_w, err_w])
+            self._answers = answer
+            try:
+                self._wait(lambda: bool(answer), self.answer_timeout, "does not answer")
+            except ZygoteError:
+                self._abandoned += 1
+                raise
+            finally:
+                self._answers = None
+            word, _, rest = answer[0].partition(" ")
+            if word != "pid":
+                raise ZygoteError(rest)
         except BaseException:
             os.close(out_r)
             os.close(err_r)
@@ -121,7 +134,25 @@ class Zygote:
         self._processes[process.pid] = process
         return process
 
-    def _line(self, timeout: float | None) -> str | None:
+    _answers: list[str] | None = None  # while spawn() waits for its answer
+
+    def _send(self, request: dict[str, Any], fds: list[int] | None = None) -> None:
+        try:
+            socket.send_fds(self.sock, [json.dumps(request).encode() + b"\n"], fds or [])
+        except OSError as err:
+            raise ZygoteError(f"the launch zygote has ended ({err.strerror})") from None
+
+    def _wait(self, done: Any, timeout: float, what: str) -> None:
+        deadline = time.monotonic() + timeout
+        while not done():
+            left = deadline - time.monotonic()
+            if self.ended:
+                raise ZygoteError("the launch zygote has ended")
+            if left <= 0:
+                raise ZygoteError(f"the launch zygote {what} after {timeout:g} s")
+            self.collect(min(left, 1.0))
+
+    def _line(self, timeout: float) -> str | None:
         """The next line from the zygote ('' when none came within ``timeout``; None at EOF)."""
         while b"\n" not in self._buffer:
             if self.sock.fileno() < 0:  # closed by close()
@@ -129,45 +160,63 @@ class Zygote:
             ready, _, _ = select.select([self.sock], [], [], timeout)
             if not ready:
                 return ""
-            chunk = self.sock.recv(65536)
+            try:
+                chunk = self.sock.recv(65536)
+            except OSError:
+                chunk = b""
             if not chunk:
                 return None
             self._buffer += chunk
         line, _, self._buffer = self._buffer.partition(b"\n")
         return line.decode()
 
-    def _exited(self, rest: str) -> None:
-        pid, _, status = rest.partition(" ")
-        process = self._processes.pop(int(pid), None)
-        if process is not None:
-            process.returncode = int(status)
-
     def collect(self, timeout: float = 0.0) -> None:
-        """Take in the exits the zygote has reported (waiting up to ``timeout`` for one)."""
-        while True:
+        """Take in what the zygote has said (waiting up to ``timeout`` for its first line)."""
+        while not self.ended:
             line = self._line(timeout)
-            if line is None:  # the zygote is gone: so are its children (parent-death signal)
+            if line is None:  # gone: its nodes are ours now (subreaper), see ZygoteProcess
                 self.ended = True
-                for process in self._processes.values():
-                    process.returncode = -signal.SIGKILL
-                self._processes.clear()
                 return
             if not line:
                 return
+            timeout = 0.0
             word, _, rest = line.partition(" ")
-            if word == "exit":
+            if word == "ready":
+                self.ready = True
+            elif word == "exit":
                 self._exited(rest)
-                timeout = 0.0
+            elif self._abandoned:  # answers come in order: first those that came too late
+                self._abandoned -= 1
+                if word == "pid":
+                    self.strays.append(int(rest))
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(int(rest), signal.SIGKILL)  # unreaped until its exit is read
+            elif self._answers is not None:
+                self._answers.append(line)
+
+    def _exited(self, rest: str) -> None:
+        pid_text, _, status = rest.partition(" ")
+        pid = int(pid_text)
+        process = self._processes.pop(pid, None)
+        if process is not None:
+            process.returncode = int(status)
+        with contextlib.suppress(ZygoteError):
+            self._send({"op": "reap", "pid": pid})  # taken in: it may be reaped now
 
     def close(self) -> None:
-        """End the zygote (its children, if any are left, get their parent-death signal)."""
+        """End the zygote (it ends when its socket closes; nodes left get their death signal)."""
         with contextlib.suppress(OSError):
             self.sock.close()
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            self.popen.wait(timeout=2)
         if self.popen.poll() is None:
             with contextlib.suppress(ProcessLookupError):
                 self.popen.kill()
-        with contextlib.suppress(subprocess.TimeoutExpired):
-            self.popen.wait(timeout=5)
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self.popen.wait(timeout=5)
+        for pipe in (self.popen.stdout, self.popen.stderr):
+            if pipe is not None:
+                pipe.close()
 
 
 class ZygoteProcess:
@@ -184,7 +233,24 @@ class ZygoteProcess:
         """The exit code (negative: the signal), or None while it runs."""
         if self.returncode is None:
             self._zygote.collect()
+        if self.returncode is None and self._zygote.ended:
+            self._poll_orphan()
         return self.returncode
+
+    def _poll_orphan(self) -> None:
+        """After the zygote's end: the node is this process's child (subreaper), or soon is."""
+        try:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+        except ChildProcessError:  # not reparented yet, or no subreaper here
+            try:
+                os.kill(self.pid, 0)
+            except ProcessLookupError:
+                self.returncode = -signal.SIGTERM  # its parent-death signal; not ours to reap
+            except PermissionError:
+                pass
+            return
+        if pid:
+            self.returncode = os.waitstatus_to_exitcode(status)
 
     def wait(self, timeout: float | None = None) -> int:
         """Wait for the exit.
@@ -193,15 +259,18 @@ class ZygoteProcess:
             subprocess.TimeoutExpired: still running after ``timeout`` seconds.
         """
         deadline = None if timeout is None else time.monotonic() + timeout
-        while self.returncode is None:
-            left = 1.0 if deadline is None else deadline - time.monotonic()
+        while self.poll() is None:
+            left = 0.05 if deadline is None else min(0.05, deadline - time.monotonic())
             if left <= 0:
                 raise subprocess.TimeoutExpired(["rosl.pkg.entry"], timeout or 0.0)
-            self._zygote.collect(min(left, 1.0))
-        return self.returncode
+            if self._zygote.ended:
+                time.sleep(left)
+            else:
+                self._zygote.collect(left)
+        return self.returncode  # type: ignore[return-value]  # set: poll() returned it
 
     def send_signal(self, signum: int) -> None:
-        """Signal the process (unless it has ended)."""
+        """Signal the process (unless it has ended: its pid may then be another's)."""
         if self.poll() is None:
             os.kill(self.pid, signum)
 
@@ -220,129 +289,13 @@ def _libc_prctl() -> Any:
 _PRCTL = _libc_prctl()  # looked up here: a forked child (maybe of a threaded parent) only calls
 
 
+def become_subreaper() -> None:
+    """Inherit orphaned descendants (PR_SET_CHILD_SUBREAPER): a lost zygote's nodes."""
+    if _PRCTL is not None:
+        _PRCTL(_PR_SET_CHILD_SUBREAPER, 1)
+
+
 def die_with_parent() -> None:
     """SIGTERM when the parent dies (PR_SET_PDEATHSIG); safe between fork and exec."""
     if _PRCTL is not None:
         _PRCTL(_PR_SET_PDEATHSIG, signal.SIGTERM)
-
-
-# --- the zygote's side --------------------------------------------------------------------------
-
-
-def _warm() -> None:
-    """Import what a node imports and build the message classes every node builds."""
-    import numpy  # noqa: F401
-    import yaml  # noqa: F401
-
-    import rosl
-    import rosl.executor
-    import rosl.node.node
-    import rosl.node.participant
-    import rosl.pkg.entry
-    import rosl.runtime
-    from rosl.idl.registry import get_message_class
-
-    rosl.compat.install(force=True)
-    for name in _WARM_TYPES:
-        with contextlib.suppress(Exception):  # a broken search path: the node will say so
-            get_message_class(name)
-
-
-def serve(sock: socket.socket) -> list[str] | None:
-    """Fork a child per request; in the child return its entry argv, in the zygote None at EOF."""
-    wake_r, wake_w = os.pipe()
-    os.set_blocking(wake_w, False)
-    signal.set_wakeup_fd(wake_w)
-    signal.signal(signal.SIGCHLD, lambda *_: None)
-    buffer = b""
-    fds: list[int] = []
-    while True:
-        _reap(sock)
-        try:
-            ready, _, _ = select.select([sock.fileno(), wake_r], [], [])
-        except InterruptedError:
-            continue
-        if wake_r in ready:
-            os.read(wake_r, 4096)
-        if sock.fileno() not in ready:
-            continue
-        data, received, _, _ = socket.recv_fds(sock, 1 << 20, 2)
-        if not data:
-            return None
-        buffer += data
-        fds += received
-        if b"\n" not in buffer:
-            continue  # the rest of the request follows
-        line, _, buffer = buffer.partition(b"\n")
-        request = json.loads(line)
-        try:
-            pid = os.fork()
-        except OSError as err:
-            sock.sendall(f"error cannot fork: {err.strerror}\n".encode())
-            fds = _closed(fds)
-            continue
-        if pid == 0:
-            signal.set_wakeup_fd(-1)
-            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
-            for fd in (wake_r, wake_w):
-                os.close(fd)
-            sock.close()
-            _become_child(request, fds)
-            return list(request["argv"])
-        fds = _closed(fds)
-        sock.sendall(f"pid {pid}\n".encode())
-
-
-def _closed(fds: list[int]) -> list[int]:
-    for fd in fds:
-        os.close(fd)
-    return []
-
-
-def _reap(sock: socket.socket) -> None:
-    while True:
-        try:
-            pid, status = os.waitpid(-1, os.WNOHANG)
-        except ChildProcessError:
-            return
-        if pid == 0:
-            return
-        sock.sendall(f"exit {pid} {os.waitstatus_to_exitcode(status)}\n".encode())
-
-
-def _become_child(request: dict[str, Any], fds: list[int]) -> None:
-    """Turn this fork into the node's process, as Popen and ``prepare_child`` would have."""
-    os.setsid()
-    die_with_parent()
-    null = os.open(os.devnull, os.O_RDONLY)
-    os.dup2(null, 0)
-    os.close(null)
-    os.dup2(fds[0], 1)
-    os.dup2(fds[1], 2)
-    for fd in fds:
-        os.close(fd)
-    if request["cwd"]:
-        os.chdir(request["cwd"])
-    os.environ.clear()
-    os.environ.update(request["env"])
-    if request["hold"]:
-        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    signal.signal(signal.SIGINT, signal.default_int_handler)  # as a fresh interpreter has it
-
-
-def main(argv: list[str]) -> int:
-    """The zygote: warm up, then serve the launcher until it closes the socket."""
-    sock = socket.socket(fileno=int(argv[0]))
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the launcher ends it (by closing, or SIGKILL)
-    _warm()
-    child = serve(sock)
-    if child is None:
-        return 0
-    from rosl.pkg import entry
-
-    sys.argv = [entry.__file__, *child]  # as `python -m rosl.pkg.entry ...` has it
-    return entry.main(child)
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -179,6 +179,25 @@ def test_a_fresh_participant_query_completes_holding_every_node_of_every_process
     assert pids == {child.pid for child in children}
 
 
+def test_the_query_sent_at_start_completes_with_every_process_without_asking_again(
+    watch: Callable[..., Watched], domain_id: int
+) -> None:
+    from rosl.introspection.session import Session
+
+    layout = [["alpha"], ["beta", "gamma"]]
+    children = [watch(SETTLING_NODES, str(len(layout)), *names) for names in layout]
+    for child in children:
+        child.wait_ready(timeout=60)
+
+    with Session(domain_id) as session:  # a CLI command: its participant asked at start
+        discovery = session.participant.discovery
+        names = sorted(n.fqn for n in session.graph().nodes())
+        queries = sorted(discovery._queries)
+
+    assert names == ["/alpha", "/beta", "/gamma"]
+    assert queries == [discovery.first_query]  # one round trip: the one made at start
+
+
 def test_a_query_with_no_nodes_anywhere_completes_with_an_empty_graph(
     observer: Participant,
 ) -> None:
