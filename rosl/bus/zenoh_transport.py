@@ -106,6 +106,7 @@ class ZenohTransport:
         self._wildcard: Any = None  # the subscriber on every topic (recorders)
         self._queries: dict[tuple[int, int, int], tuple[Any, bytes]] = {}
         self._key_hashes: dict[str, tuple[int, int]] = {}
+        self._cached: set[int] = set()  # topics whose publishers Zenoh caches (transient local)
         self.local = LocalEntities(self)
         self._rosl_sub = self.session.declare_subscriber(
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
@@ -162,6 +163,28 @@ class ZenohTransport:
                         route.key, self._on_query, complete=True
                     )
 
+    def keep_history(self, topic: int, depth: int, reliable: bool) -> None:
+        """A transient-local publisher was made (the seam's optional hook): cache on Zenoh.
+
+        Its topic's key is put through an ``AdvancedPublisher`` keeping ``depth`` samples, as
+        rmw_zenoh declares one (see :mod:`rosl.bus.zenoh_history`); late subscriptions of
+        any process, ROS 2's too, are served from it, so rosl's own replays of the topic are
+        not sent.
+        """
+        from rosl.bus.zenoh_history import declare_cached_publisher
+
+        with self._lock:
+            route = self._routes.get(topic)
+            if route is None or not route.key or self._closed or topic in self._cached:
+                return
+            old = self._publishers.pop(route.key, None)
+            self._publishers[route.key] = declare_cached_publisher(
+                self.session, route.key, depth, reliable
+            )
+            self._cached.add(topic)
+        if old is not None:
+            old.undeclare()
+
     def subscribe(self, key: str) -> None:
         """Declare a Zenoh subscriber on a data key (idempotent)."""
         with self._lock:
@@ -212,6 +235,8 @@ class ZenohTransport:
         if routed and kind in (Kind.RESPONSE, Kind.FAILURE) and flags & Flags.ADDRESSED:
             self._reply(kind, payload)
             return
+        if kind == Kind.REPLAY and topic in self._cached:
+            return  # late subscriptions query the topic's Zenoh cache instead
         try:
             self.session.put(f"{ROSL_PREFIX}/{self.domain}/{channel}", data)
         except Exception as err:  # zenoh.ZError: a closed session
@@ -295,6 +320,20 @@ class ZenohTransport:
             self.local.update(None)
         elif message.get("op") == "query":
             self.foreign.answer(f"{message['sender']}:{message['qid']}")
+        elif message.get("op") == "replay":
+            self._query_history(message)
+
+    def _query_history(self, message: dict[str, Any]) -> None:
+        """A late transient-local subscription of this process: ask the topic's caches."""
+        from rosl.bus.zenoh_history import query_history
+
+        try:
+            sender, endpoint = message["target"]
+            target = (int(str(sender), 16), int(endpoint))
+            name = str(message["topic"])
+        except (KeyError, TypeError, ValueError):
+            return
+        query_history(self.session, self.domain, name, target, self._hashes, self._deliver)
 
     # --- receiving ------------------------------------------------------------------------------
 
