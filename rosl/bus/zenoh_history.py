@@ -30,11 +30,9 @@ from rosl.bus import zenoh_wire as wire
 from rosl.bus.header import Kind
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
-
     import zenoh
 
-    from rosl.bus.wire import Delivery
+    from rosl.bus.zenoh_transport import ZenohTransport
 
 HEARTBEAT_S = 1.0  # rmw_zenoh's sample-miss detection period (sporadic heartbeat)
 QUERY_TIMEOUT_S = 10.0  # how long the caches have to answer one history query
@@ -61,23 +59,14 @@ def history_selector(domain: int, name: str) -> str:
     return f"{domain}/{name.strip('/')}/*/*/{ADVANCED}/**"
 
 
-def query_history(
-    session: zenoh.Session,
-    domain: int,
-    name: str,
-    target: tuple[int, int],
-    hashes: Callable[[str], tuple[int, int]],
-    deliver: Callable[[Delivery], None],
-) -> None:
+def query_history(transport: ZenohTransport, name: str, target: tuple[int, int]) -> None:
     """Ask every publication cache of topic ``name`` for its samples, for one subscription.
 
     Args:
-        session: the Zenoh session.
-        domain: the ROS domain id.
+        transport: the Zenoh transport of this process (its session, key hashes, the ids of
+            GIDs, and where deliveries go: each cached sample becomes a ``REPLAY``).
         name: the topic, fully qualified.
         target: (process, endpoint) of the subscription the samples are for.
-        hashes: rosl's (topic, type) hashes of a data key expression (ValueError: not one).
-        deliver: receives each cached sample as a ``REPLAY`` delivery (on a Zenoh thread).
     """
     import zenoh
 
@@ -88,15 +77,16 @@ def query_history(
         if sample is None or sample.attachment is None:
             return
         try:
-            topic, type_ = hashes(str(sample.key_expr))
+            topic, type_ = transport._hashes(str(sample.key_expr))
             seq, stamp, gid = wire.decode_attachment(sample.attachment.to_bytes())
         except ValueError:
             return  # not a ROS 2 sample: rmw_zenoh drops it too
-        deliver(
+        sender, endpoint = transport.identity(gid)
+        transport._deliver(
             Delivery(
                 Kind.REPLAY,
-                int.from_bytes(gid[:8], "little") | 1,
-                int.from_bytes(gid[8:10], "little"),
+                sender,
+                endpoint,
                 seq & 0xFFFFFFFF,
                 topic,
                 type_,
@@ -107,8 +97,8 @@ def query_history(
             )
         )
 
-    session.get(
-        f"{history_selector(domain, name)}?_anyke", on_reply,
+    transport.session.get(
+        f"{history_selector(transport.domain, name)}?_anyke", on_reply,
         target=zenoh.QueryTarget.ALL, consolidation=zenoh.ConsolidationMode.NONE,
         accept_replies=zenoh.ReplyKeyExpr.ANY, timeout=QUERY_TIMEOUT_S,
     )  # fmt: skip

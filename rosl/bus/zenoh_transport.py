@@ -61,11 +61,16 @@ class _Route:
     service: bool
 
 
+ROSL_ONLY = "rosl_msgs/"  # rosl's own control types (lock-step answers): rosl datagrams only
+
+
 def type_hash_of(type_name: str, service: bool) -> str:
-    """The RIHS01 hash of a type this process can load ("" when it cannot)."""
+    """The RIHS01 hash of a type this process can load ("" when it cannot, or rosl's own)."""
     from rosl.idl import registry
     from rosl.idl.errors import InterfaceError
 
+    if type_name.startswith(ROSL_ONLY):
+        return ""  # no ROS 2 node reads them; they keep rosl's process and endpoint ids
     try:
         if service:
             registry.get_service_class(type_name)
@@ -83,6 +88,7 @@ class ZenohTransport:
     def __init__(self, domain: int) -> None:
         from rosl.bus.zenoh_config import open_session, session_config
         from rosl.bus.zenoh_graph import ForeignGraph, LocalEntities
+        from rosl.bus.zenoh_identity import Identities
 
         self.name = "the Zenoh transport"
         self.fix_hint = (
@@ -108,6 +114,7 @@ class ZenohTransport:
         self._key_hashes: dict[str, tuple[int, int]] = {}
         self._cached: set[int] = set()  # topics whose publishers Zenoh caches (transient local)
         self.local = LocalEntities(self)
+        self.identities = Identities(self.session, domain, self.zid)
         self._rosl_sub = self.session.declare_subscriber(
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
         )
@@ -203,7 +210,7 @@ class ZenohTransport:
         with self._lock:
             if self._wildcard is None and not self._closed:
                 self._wildcard = self.session.declare_subscriber(
-                    f"{self.domain}/**", self._on_sample
+                    f"{self.domain}/**", self._on_any_sample
                 )
 
     # --- sending --------------------------------------------------------------------------------
@@ -315,6 +322,7 @@ class ZenohTransport:
         if not isinstance(message, dict):
             return
         if message.get("op") == "hello":
+            self.identities.announce(int(str(message["process"]["sender"]), 16))
             self.local.update(message["process"])
         elif message.get("op") == "bye":
             self.local.update(None)
@@ -333,7 +341,14 @@ class ZenohTransport:
             name = str(message["topic"])
         except (KeyError, TypeError, ValueError):
             return
-        query_history(self.session, self.domain, name, target, self._hashes, self._deliver)
+        query_history(self, name, target)
+
+    def identity(self, gid: bytes) -> tuple[int, int]:
+        """(process, endpoint) of a GID: a rosl endpoint's own ids, else derived from it."""
+        owner = self.identities.owners.get(gid)
+        if owner is not None:
+            return owner
+        return int.from_bytes(gid[:8], "little") | 1, int.from_bytes(gid[8:10], "little")
 
     # --- receiving ------------------------------------------------------------------------------
 
@@ -359,6 +374,18 @@ class ZenohTransport:
         return hashes
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
+        """A sample of a topic this process subscribed to: for its subscriptions."""
+        self._sample(sample, False)
+
+    def _on_any_sample(self, sample: zenoh.Sample) -> None:
+        """A sample of the wildcard subscriber: for the recorders and monitors only.
+
+        A process with both (a simulator recording itself) gets each sample from both
+        subscribers; each copy goes to one kind of receiver, so none gets it twice.
+        """
+        self._sample(sample, True)
+
+    def _sample(self, sample: zenoh.Sample, want_all: bool) -> None:
         try:
             topic, type_ = self._hashes(str(sample.key_expr))
             attachment = sample.attachment
@@ -367,8 +394,12 @@ class ZenohTransport:
             seq, stamp, gid = wire.decode_attachment(attachment.to_bytes())
         except ValueError:
             return
-        sender = int.from_bytes(gid[:8], "little") | 1
-        endpoint = int.from_bytes(gid[8:10], "little")
+        owner = self.identities.owners.get(gid)  # a rosl publisher: the ids the graph knows
+        if owner is None:
+            sender = int.from_bytes(gid[:8], "little") | 1
+            endpoint = int.from_bytes(gid[8:10], "little")
+        else:
+            sender, endpoint = owner
         payload = sample.payload.to_bytes()
         self._deliver(
             Delivery(
@@ -381,7 +412,8 @@ class ZenohTransport:
                 stamp,
                 time.time_ns(),
                 memoryview(payload),
-            )
+            ),
+            want_all,
         )
 
     def _on_query(self, query: zenoh.Query) -> None:
@@ -414,10 +446,15 @@ class ZenohTransport:
             )
         )
 
-    def _deliver(self, delivery: Delivery) -> None:
+    def _deliver(self, delivery: Delivery, want_all: bool | None = None) -> None:
+        """Hand a delivery to the receivers of its channel (of one kind, when ``want_all``)."""
         channel = channel_of(delivery.topic)
         with self._lock:
-            receivers = [r for r in self._receivers if channel in r.channels]
+            receivers = [
+                r
+                for r in self._receivers
+                if channel in r.channels and (want_all is None or r.reader.want_all is want_all)
+            ]
         for receiver in receivers:
             receiver.put_delivery(delivery)
 
@@ -448,6 +485,8 @@ class ZenohTransport:
         for receiver in list(self._receivers):
             receiver.close()
         self.foreign.close()
+        with contextlib.suppress(Exception):  # a closed session undeclared them already
+            self.identities.close()
         self.local.update(None)
         with contextlib.suppress(Exception):  # closing at exit: nothing left to tell
             self.session.close()  # type: ignore[no-untyped-call]
