@@ -193,17 +193,23 @@ class ZenohTransport:
             old.undeclare()
 
     def subscribe(self, key: str) -> None:
-        """Declare a Zenoh subscriber on a data key (idempotent)."""
+        """Declare Zenoh subscribers on a data key and its Humble form (idempotent).
+
+        ROS 2 Humble's rmw_zenoh has no type hashes: it writes ``TypeHashNotSupported`` in
+        their place, so its publishers are heard on that key too (matched by name and type).
+        """
         with self._lock:
-            if key not in self._subscribers and not self._closed:
-                self._subscribers[key] = self.session.declare_subscriber(key, self._on_sample)
+            for each in (key, wire.humble_key(key)):
+                if each not in self._subscribers and not self._closed:
+                    self._subscribers[each] = self.session.declare_subscriber(each, self._on_sample)
 
     def unsubscribe(self, key: str) -> None:
-        """Undeclare a data key's subscriber."""
+        """Undeclare a data key's subscribers."""
         with self._lock:
-            subscriber = self._subscribers.pop(key, None)
-        if subscriber is not None:
-            subscriber.undeclare()
+            subscribers = [self._subscribers.pop(k, None) for k in (key, wire.humble_key(key))]
+        for subscriber in subscribers:
+            if subscriber is not None:
+                subscriber.undeclare()
 
     def subscribe_all(self) -> None:
         """Receive every topic of the domain (recorders and monitors)."""

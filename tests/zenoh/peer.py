@@ -6,6 +6,10 @@ with their encapsulation header, services as a complete queryable answered to ge
 
     python peer.py talker|listener|server|client PORT DOMAIN [a b]
     python peer.py latched_talker|latched_listener PORT DOMAIN
+    python peer.py humble_talker PORT DOMAIN
+
+``humble_talker`` is the talker as ROS 2 Humble's rmw_zenoh names it: ``TypeHashNotSupported``
+where the type hash goes, in its key expression and its token.
 
 ``latched_*`` are transient-local with depth 3, as rmw_zenoh declares them: the talker an
 ``AdvancedPublisher`` caching 3 samples with publisher detection (it publishes
@@ -68,6 +72,7 @@ def main() -> None:
         "client": "add_two_ints_client",
         "latched_talker": "latched_talker",
         "latched_listener": "latched_listener",
+        "humble_talker": "talker",
     }[role]
     prefix = f"@ros2_lv/{domain}/{zid}/0"
     tokens = [session.liveliness().declare_token(f"{prefix}/0/NN/%/%/{node}")]
@@ -75,6 +80,9 @@ def main() -> None:
         kind = "MP" if role == "latched_talker" else "MS"
         token = f"{prefix}/10/{kind}/%/%/{node}/%latched/{STRING}/{STRING_HASH}/{LATCHED_QOS}"
         key = f"{domain}/latched/{STRING}/{STRING_HASH}"
+    elif role == "humble_talker":
+        token = f"{prefix}/10/MP/%/%/{node}/%chatter/{STRING}/TypeHashNotSupported/{QOS}"
+        key = f"{domain}/chatter/{STRING}/TypeHashNotSupported"
     elif role in ("talker", "listener"):
         kind = "MP" if role == "talker" else "MS"
         token = f"{prefix}/10/{kind}/%/%/{node}/%chatter/{STRING}/{STRING_HASH}/{QOS}"
@@ -89,7 +97,7 @@ def main() -> None:
         latched(session, role, key, me, zid)
         return
     print(f"ready {zid}", flush=True)
-    if role == "talker":
+    if role in ("talker", "humble_talker"):
         publisher = session.declare_publisher(key)
         seq = 0
         while True:

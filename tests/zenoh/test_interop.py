@@ -144,3 +144,29 @@ def router_peer_path() -> str:
     from tests.zenoh.conftest import PEER
 
     return PEER
+
+
+def test_a_humble_peer_without_type_hashes_is_heard_by_name_and_type(
+    router: Router, processes: Processes, domain_id: int, ros: object
+) -> None:
+    from std_msgs.msg import String
+
+    import rosl
+
+    router.peer(processes, "humble_talker", domain_id)
+    node = rosl.create_node("rosl_listener")
+    heard: list[str] = []
+    node.create_subscription(String, "/chatter", lambda m: heard.append(m.data), 10)
+
+    def received() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return any(h.startswith("Hello World") for h in heard)
+
+    assert wait_until(received, 30), heard
+    echo = processes.rosl("topic", "echo", "/chatter", "--once")
+    out, err = echo.communicate(timeout=60)
+    assert echo.returncode == 0, err
+    assert "data: 'Hello World: " in out
+    listing = processes.rosl("topic", "list", "-t")
+    out, err = listing.communicate(timeout=60)
+    assert "/chatter [std_msgs/msg/String]" in out, (out, err)
