@@ -39,10 +39,8 @@ def test_a_rosl_node_hears_the_peer_talker_and_the_peer_hears_rosl(
     assert re.search(r"heard 'from rosl' seq=\d+ gidlen=16 size=33", listener.text["out"])
 
 
-def test_rosl_cli_echo_list_and_node_list_see_the_peer(
-    router: Router, processes: Processes, domain_id: int
-) -> None:
-    router.peer(processes, "talker", domain_id)
+def _echo_and_list_chatter(processes: Processes) -> None:
+    """``rosl topic echo --once`` prints the peer talker's message; ``topic list`` shows it."""
     echo = processes.rosl("topic", "echo", "/chatter", "--once")
     out, err = echo.communicate(timeout=60)
     assert echo.returncode == 0, err
@@ -50,6 +48,13 @@ def test_rosl_cli_echo_list_and_node_list_see_the_peer(
     listing = processes.rosl("topic", "list", "-t")
     out, err = listing.communicate(timeout=60)
     assert "/chatter [std_msgs/msg/String]" in out, (out, err)
+
+
+def test_rosl_cli_echo_list_and_node_list_see_the_peer(
+    router: Router, processes: Processes, domain_id: int
+) -> None:
+    router.peer(processes, "talker", domain_id)
+    _echo_and_list_chatter(processes)
     nodes = processes.rosl("node", "list")
     out, err = nodes.communicate(timeout=60)
     assert "/talker" in out.split(), (out, err)
@@ -163,10 +168,4 @@ def test_a_humble_peer_without_type_hashes_is_heard_by_name_and_type(
         return any(h.startswith("Hello World") for h in heard)
 
     assert wait_until(received, 30), heard
-    echo = processes.rosl("topic", "echo", "/chatter", "--once")
-    out, err = echo.communicate(timeout=60)
-    assert echo.returncode == 0, err
-    assert "data: 'Hello World: " in out
-    listing = processes.rosl("topic", "list", "-t")
-    out, err = listing.communicate(timeout=60)
-    assert "/chatter [std_msgs/msg/String]" in out, (out, err)
+    _echo_and_list_chatter(processes)
