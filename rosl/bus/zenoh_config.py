@@ -114,7 +114,23 @@ def router_config(listen: str | None = None) -> zenoh.Config:
     config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
     if listen:  # the command line wins over the file and the overrides
         _insert(config, "listen/endpoints", json.dumps([listen]), "--listen")
+        if listen.endswith(":0"):  # a port the system picks: read back from the admin space
+            _insert(config, "adminspace/enabled", "true", "--listen")
     return config
+
+
+def listening_on(session: zenoh.Session, timeout: float = 2.0) -> str:
+    """Where a router listens, as its admin space says ("" at once when it is not enabled)."""
+    import zenoh
+
+    try:
+        for reply in session.get(f"@/{session.info.zid()}/router", timeout=timeout):
+            if reply.ok is not None:
+                locators = json.loads(reply.ok.payload.to_string()).get("locators") or []
+                return ", ".join(str(locator) for locator in locators)
+    except (zenoh.ZError, ValueError, AttributeError):
+        pass
+    return ""
 
 
 def check_auth(config: zenoh.Config) -> None:

@@ -57,7 +57,7 @@ class Secured:
         self, folder: Path, router: str, tls: dict[str, str] | None = None, users: bool = True
     ) -> None:
         self.folder = folder
-        self.router = router  # the router's endpoint, e.g. tcp/127.0.0.1:7447
+        self.router = router  # its endpoint, e.g. tcp/127.0.0.1:7447 (port 0: read it back)
         self.tls = tls
         self.users = folder / "users.txt" if users else None
         if self.users is not None:
@@ -80,6 +80,7 @@ class Secured:
         path.write_text(json.dumps({
             "mode": "router", "listen": {"endpoints": [self.router]},
             "scouting": {"multicast": {"enabled": False}}, "transport": self._transport(None),
+            "adminspace": {"enabled": True},  # it prints the port it was given
         }))  # fmt: skip
         return path
 

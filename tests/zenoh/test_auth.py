@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from tests.conftest import ChildOutput, Processes
-from tests.zenoh.conftest import free_port, wait_output
+from tests.zenoh.conftest import ROUTER_PORT, wait_output
 from tests.zenoh.secure import LINKED, Secured, make_tls
 
 if TYPE_CHECKING:
@@ -24,13 +24,17 @@ LISTEN_TCP, LISTEN_TLS = "tcp/127.0.0.1:0", "tls/127.0.0.1:0"
 
 
 def _router(processes: Processes, secured: Secured) -> None:
+    """Start the router of ``secured`` (on port 0) and point its sessions at its real port."""
     router_file = secured.router_file()
     router = processes.rosl(
         "zenoh", "router",
         env={"ZENOH_ROUTER_CONFIG_URI": str(router_file), "ZENOH_CONFIG_OVERRIDE": ""},
     )  # fmt: skip
     output = ChildOutput(router)
-    assert wait_output(output, f"the endpoints of {router_file}"), output.text
+    assert wait_output(output, "listening on"), output.text
+    found = ROUTER_PORT.search(output.text["out"])
+    assert found, output.text
+    secured.router = f"{secured.router.split('/')[0]}/127.0.0.1:{found.group(1)}"
 
 
 def _exchange(processes: Processes, secured: Secured, listen: str) -> None:
@@ -56,7 +60,7 @@ def _exchange(processes: Processes, secured: Secured, listen: str) -> None:
 def test_user_and_password_peers_exchange_data_and_strangers_stay_out(
     processes: Processes, domain_id: int, tmp_path: Path
 ) -> None:
-    secured = Secured(tmp_path, f"tcp/127.0.0.1:{free_port()}")
+    secured = Secured(tmp_path, "tcp/127.0.0.1:0")
     _router(processes, secured)
     _exchange(processes, secured, LISTEN_TCP)
     # the router admits the right password only (a refused session sees nobody)
@@ -73,7 +77,7 @@ def test_tls_with_user_and_password_carries_data_and_a_stranger_ca_stays_out(
     processes: Processes, domain_id: int, tmp_path: Path
 ) -> None:
     tls = make_tls(tmp_path, ["127.0.0.1"])
-    secured = Secured(tmp_path, f"tls/127.0.0.1:{free_port()}", tls)
+    secured = Secured(tmp_path, "tls/127.0.0.1:0", tls)
     _router(processes, secured)
     _exchange(processes, secured, LISTEN_TLS)
     other = tmp_path / "other"
@@ -102,7 +106,7 @@ def test_a_missing_dictionary_file_is_one_line_naming_it(
 ) -> None:
     missing = tmp_path / "nowhere" / "users.txt"
     child = processes.rosl(
-        "zenoh", "router", "--listen", f"tcp/127.0.0.1:{free_port()}",
+        "zenoh", "router", "--listen", "tcp/127.0.0.1:0",
         env={"ZENOH_CONFIG_OVERRIDE": f'transport/auth/usrpwd/dictionary_file="{missing}"'},
     )  # fmt: skip
     _, err = child.communicate(timeout=60)
