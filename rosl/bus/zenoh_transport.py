@@ -36,6 +36,7 @@ from rosl.bus.header import type_hash as hash_type
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.transport import channel_of
 from rosl.bus.wire import Delivery, Reader, StreamStats
+from rosl.bus.wire import _window as count_in_window
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -571,8 +572,7 @@ class ZenohReceiver:
         for item in items:
             if isinstance(item, bytes):
                 datagrams.append(item)
-            else:
-                self._count(item)
+            elif self._count(item):
                 out.append(item)
         if datagrams:
             source = iter(datagrams)
@@ -588,21 +588,23 @@ class ZenohReceiver:
                 pass
         return 1 if items else 0
 
-    def _count(self, delivery: Delivery) -> None:
-        """Received and lost counts per publisher, as the reader keeps them for datagrams."""
+    def _count(self, delivery: Delivery) -> bool:
+        """Count a message in its publisher's stream with the reader's own window.
+
+        The same received/lost/duplicate accounting as the multicast reader's (a gap counts
+        as lost until its messages arrive late); False for a duplicate, which is dropped.
+        """
         if delivery.kind != Kind.DATA:
-            return
+            return True
         key = (delivery.sender, delivery.endpoint)
         stats = self.reader.streams.get(key)
         if stats is None:
-            stats = StreamStats(delivery.topic, last_seq=delivery.seq - 1)
+            stats = StreamStats(
+                delivery.topic, last_seq=(delivery.seq - 1) & 0xFFFFFFFF,
+                last_received=delivery.received,
+            )  # fmt: skip
             self.reader.streams[key] = stats
-        gap = delivery.seq - stats.last_seq
-        if 1 < gap <= 1 << 16:
-            stats.lost += gap - 1
-        stats.last_seq = max(stats.last_seq, delivery.seq)
-        stats.received += 1
-        stats.last_received = delivery.received
+        return count_in_window(stats, delivery.seq, delivery.stamp, delivery.received, True) <= 0
 
     def wake(self) -> None:
         """Make a blocked (or the next) :meth:`poll` return."""

@@ -7,9 +7,11 @@ with their encapsulation header, services as a complete queryable answered to ge
     python peer.py talker|listener|server|client PORT DOMAIN [a b]
     python peer.py latched_talker|latched_listener PORT DOMAIN
     python peer.py humble_talker PORT DOMAIN
+    python peer.py gappy_talker PORT DOMAIN
 
 ``humble_talker`` is the talker as ROS 2 Humble's rmw_zenoh names it: ``TypeHashNotSupported``
-where the type hash goes, in its key expression and its token.
+where the type hash goes, in its key expression and its token. ``gappy_talker`` waits for a
+subscriber, then sends sequence numbers 1, 2, 3, 6, 7 and 7 again (two lost, one duplicate).
 
 ``latched_*`` are transient-local with depth 3, as rmw_zenoh declares them: the talker an
 ``AdvancedPublisher`` caching 3 samples with publisher detection (it publishes
@@ -73,6 +75,7 @@ def main() -> None:
         "latched_talker": "latched_talker",
         "latched_listener": "latched_listener",
         "humble_talker": "talker",
+        "gappy_talker": "talker",
     }[role]
     prefix = f"@ros2_lv/{domain}/{zid}/0"
     tokens = [session.liveliness().declare_token(f"{prefix}/0/NN/%/%/{node}")]
@@ -83,8 +86,8 @@ def main() -> None:
     elif role == "humble_talker":
         token = f"{prefix}/10/MP/%/%/{node}/%chatter/{STRING}/TypeHashNotSupported/{QOS}"
         key = f"{domain}/chatter/{STRING}/TypeHashNotSupported"
-    elif role in ("talker", "listener"):
-        kind = "MP" if role == "talker" else "MS"
+    elif role in ("talker", "listener", "gappy_talker"):
+        kind = "MS" if role == "listener" else "MP"
         token = f"{prefix}/10/{kind}/%/%/{node}/%chatter/{STRING}/{STRING_HASH}/{QOS}"
         key = f"{domain}/chatter/{STRING}/{STRING_HASH}"
     else:
@@ -97,6 +100,15 @@ def main() -> None:
         latched(session, role, key, me, zid)
         return
     print(f"ready {zid}", flush=True)
+    if role == "gappy_talker":
+        publisher = session.declare_publisher(key)
+        while not publisher.matching_status:
+            time.sleep(0.05)
+        time.sleep(0.5)  # every subscriber of the router's graph has its route by now
+        for seq in (1, 2, 3, 6, 7, 7):
+            publisher.put(string_cdr(f"m{seq}"), attachment=attachment(seq, time.time_ns(), me))
+        while True:
+            time.sleep(1)
     if role in ("talker", "humble_talker"):
         publisher = session.declare_publisher(key)
         seq = 0

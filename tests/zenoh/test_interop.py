@@ -169,3 +169,30 @@ def test_a_humble_peer_without_type_hashes_is_heard_by_name_and_type(
 
     assert wait_until(received, 30), heard
     _echo_and_list_chatter(processes)
+
+
+def test_a_gap_in_the_peers_sequence_numbers_is_counted_lost_and_a_duplicate_dropped(
+    router: Router, processes: Processes, domain_id: int, ros: object
+) -> None:
+    from std_msgs.msg import String
+
+    import rosl
+
+    node = rosl.create_node("rosl_listener")
+    heard: list[str] = []
+    subscription = node.create_subscription(String, "/chatter", lambda m: heard.append(m.data), 10)
+    router.peer(processes, "gappy_talker", domain_id)
+
+    def received() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return "m7" in heard
+
+    assert wait_until(received, 30), heard
+
+    def spun() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return False
+
+    wait_until(spun, 1.0)  # a second m7 would be taken by now
+    assert heard == ["m1", "m2", "m3", "m6", "m7"]
+    assert subscription.lost == 2
