@@ -113,7 +113,7 @@ class ZenohTransport:
         self._wildcard: Any = None  # the subscriber on every topic (recorders)
         self._queries: dict[tuple[int, int, int], tuple[Any, bytes]] = {}
         self._key_hashes: dict[str, tuple[int, int]] = {}
-        self._cached: set[int] = set()  # topics whose publishers Zenoh caches (transient local)
+        self._cached: dict[int, int] = {}  # topic -> its transient-local publishers (cached)
         self.local = LocalEntities(self)
         self.identities = Identities(self.session, domain, self.zid)
         self._rosl_sub = self.session.declare_subscriber(
@@ -183,15 +183,29 @@ class ZenohTransport:
 
         with self._lock:
             route = self._routes.get(topic)
-            if route is None or not route.key or self._closed or topic in self._cached:
+            if route is None or not route.key or self._closed:
                 return
+            self._cached[topic] = self._cached.get(topic, 0) + 1
+            if self._cached[topic] > 1:
+                return  # one cache per topic and process (the first publisher's depth)
             old = self._publishers.pop(route.key, None)
             self._publishers[route.key] = declare_cached_publisher(
                 self.session, route.key, depth, reliable
             )
-            self._cached.add(topic)
         if old is not None:
             old.undeclare()
+
+    def drop_history(self, topic: int) -> None:
+        """A transient-local publisher went: its topic's cache goes with the last of them."""
+        with self._lock:
+            count = self._cached.pop(topic, 0)
+            if count > 1:
+                self._cached[topic] = count - 1
+                return
+            route = self._routes.get(topic)
+            cached = self._publishers.pop(route.key, None) if route and count else None
+        if cached is not None and not self._closed:
+            cached.undeclare()
 
     def subscribe(self, key: str) -> None:
         """Declare Zenoh subscribers on a data key and its Humble form (idempotent).

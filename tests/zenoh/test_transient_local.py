@@ -147,3 +147,22 @@ def _peer() -> str:
     from tests.zenoh.conftest import PEER
 
     return PEER
+
+
+def test_a_destroyed_publishers_cache_goes_with_it(
+    router: Router, processes: Processes, domain_id: int, ros: object
+) -> None:
+    import rosl
+
+    talker = rosl.create_node("latched_talker")
+    talker.destroy_publisher(_publish_five(talker))
+    listener = rosl.create_node("late_listener")
+    heard: list[str] = []
+    _late_subscription(listener, heard)
+    _settle([talker, listener])
+    assert heard == []  # no history of a publisher that is gone
+    # while the subscription does hear a publisher made afterwards (keeping its last three)
+    _publish_five(talker)
+    assert _spin_until([talker, listener], lambda: len(heard) >= 3), heard
+    _settle([talker, listener])
+    assert heard == LAST_THREE
