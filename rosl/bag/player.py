@@ -105,6 +105,9 @@ class _Outlet:
         self.history: collections.deque[tuple[int, bytes]] | None = (
             collections.deque(maxlen=depth) if keep else None
         )
+        cache = getattr(writer.transport, "keep_history", None)
+        if keep and cache is not None:  # a transport that keeps history itself (Zenoh)
+            cache(writer.topic, depth, str(qos.get("reliability", "")).upper() != "BEST_EFFORT")
 
     def send(self, data: bytes) -> None:
         seq = self.writer.send(data)

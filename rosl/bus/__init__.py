@@ -8,7 +8,9 @@ poll whole deliveries, wake-ups); ``multicast.py`` is the default transport and
 ``inprocess.py`` a one-process transport for tests. ``ROSL_TRANSPORT=zenoh`` picks
 ``zenoh_transport.py``: the same seam over Zenoh in ROS 2's rmw_zenoh wire format
 (``zenoh_wire.py``: keys, tokens, QoS strings, attachments, GIDs; ``zenoh_graph.py``: liveliness
-tokens and other implementations' nodes; ``zenoh_config.py``: sessions, routers, settings).
+tokens and other implementations' nodes; ``zenoh_config.py``: sessions, routers, settings;
+``zenoh_history.py``: transient local through publication caches; ``zenoh_identity.py``: GIDs
+back to rosl's process and endpoint ids).
 Large messages between processes of one host take shared memory beside multicast: ``shm.py``
 (when, ring names, the host identity, cleanup of crashed processes' rings) over
 ``shm_ring.py`` (the ring file, its writer, the readers' checked copies).

@@ -6,6 +6,8 @@
   Zenoh configuration file to start from instead;
 * ``rosl zenoh router`` opens a session in router mode listening on ``tcp/127.0.0.1:7447``;
   ``ZENOH_ROUTER_CONFIG_URI`` names a file to start from instead;
+* peers dial each other one way only (the greater Zenoh id dials) unless the file says
+  otherwise: two peers dialling each other at once lose both links when they authenticate;
 * ``ZENOH_CONFIG_OVERRIDE`` (``key=value;key=value``, each value JSON5) applies last to
   both, e.g. ``connect/endpoints=["tcp/192.168.1.2:7447"]``.
 """
@@ -24,6 +26,8 @@ if TYPE_CHECKING:
 
 ROUTER_ENDPOINT = "tcp/localhost:7447"
 ROUTER_LISTEN = "tcp/127.0.0.1:7447"
+GOSSIP = "scouting/gossip"
+ONE_DIAL = '{"peer": {"to_router": "always", "to_peer": "greater-zid"}}'
 
 
 def _zenoh() -> object:
@@ -91,7 +95,13 @@ def session_config() -> zenoh.Config:
         "listen/endpoints": '["tcp/localhost:0"]',
         "scouting/multicast/enabled": "false",
     }
-    return apply_overrides(_base("ZENOH_SESSION_CONFIG_URI", defaults))
+    config = _base("ZENOH_SESSION_CONFIG_URI", defaults)
+    if config.get_json(f"{GOSSIP}/autoconnect_strategy") in ("null", ""):
+        # one dial per pair of peers: when both dial at once, authenticated links (user and
+        # password) are refused on both sides and never retried, and the router does not
+        # carry what the two peers say to each other
+        _insert(config, f"{GOSSIP}/autoconnect_strategy", ONE_DIAL, "autoconnect_strategy")
+    return apply_overrides(config)
 
 
 def router_config(listen: str | None = None) -> zenoh.Config:
@@ -104,13 +114,48 @@ def router_config(listen: str | None = None) -> zenoh.Config:
     config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
     if listen:  # the command line wins over the file and the overrides
         _insert(config, "listen/endpoints", json.dumps([listen]), "--listen")
+        if listen.endswith(":0"):  # a port the system picks: read back from the admin space
+            _insert(config, "adminspace/enabled", "true", "--listen")
     return config
+
+
+def listening_on(session: zenoh.Session, timeout: float = 2.0) -> str:
+    """Where a router listens, as its admin space says ("" at once when it is not enabled)."""
+    import zenoh
+
+    try:
+        for reply in session.get(f"@/{session.info.zid()}/router", timeout=timeout):
+            if reply.ok is not None:
+                locators = json.loads(reply.ok.payload.to_string()).get("locators") or []
+                return ", ".join(str(locator) for locator in locators)
+    except (zenoh.ZError, ValueError, AttributeError):
+        pass
+    return ""
+
+
+def check_auth(config: zenoh.Config) -> None:
+    """Refuse half a user/password pair, which Zenoh ignores (it links without it).
+
+    Raises:
+        BusError: ``transport/auth/usrpwd`` has a user and no password, or the reverse.
+    """
+    given = {
+        field: config.get_json(f"transport/auth/usrpwd/{field}") not in ("null", '""', "")
+        for field in ("user", "password")
+    }
+    if given["user"] != given["password"]:
+        have, lack = ("user", "password") if given["user"] else ("password", "user")
+        raise BusError(
+            f"transport/auth/usrpwd has a {have} but no {lack} (Zenoh ignores half a pair: "
+            "set both, in the configuration file or ZENOH_CONFIG_OVERRIDE)"
+        )
 
 
 def open_session(config: zenoh.Config) -> zenoh.Session:
     """Open a Zenoh session; BusError naming the endpoints when Zenoh cannot."""
     import zenoh
 
+    check_auth(config)
     try:
         return zenoh.open(config)
     except zenoh.ZError as err:

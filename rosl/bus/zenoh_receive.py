@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.bus.header import Kind
 from rosl.bus.transport import channel_of
 from rosl.bus.wire import Delivery, Reader, StreamStats
+from rosl.bus.wire import _window as count_in_window
 from rosl.bus.zenoh_wire import GID_SIZE
 
 if TYPE_CHECKING:
@@ -49,7 +50,7 @@ def read_attachment(data: bytes) -> tuple[int, int, int, int]:
 
 
 def sample_callback(
-    transport: ZenohTransport, hashes: tuple[int, int] | None
+    transport: ZenohTransport, hashes: tuple[int, int] | None, want_all: bool
 ) -> Callable[[zenoh.Sample], None]:
     """The callback of a data subscriber: its samples as DATA deliveries to the receivers.
 
@@ -57,9 +58,13 @@ def sample_callback(
         transport: whose receivers get the deliveries.
         hashes: (topic, type) hashes of the subscriber's one key; None for a wildcard
             subscriber, which reads them from each sample's key.
+        want_all: the wildcard subscriber's samples go to the receivers that want every topic
+            (recorders, monitors), a topic subscriber's to the others: a process with both (a
+            simulator recording itself) gets each sample from both, and no receiver twice.
     """
     unpack = _ATTACHMENT.unpack
     time_ns = time.time_ns
+    identities = transport.identities  # its map is replaced as tokens come and go
 
     def on_sample(sample: zenoh.Sample) -> None:
         attachment = sample.attachment
@@ -67,18 +72,24 @@ def sample_callback(
             return  # rmw_zenoh drops samples without one too
         try:
             topic, type_ = hashes or transport.key_hashes(str(sample.key_expr))
-            seq, stamp, length, low, endpoint = unpack(attachment.to_bytes())
+            data = attachment.to_bytes()
+            seq, stamp, length, low, endpoint = unpack(data)
         except (ValueError, struct.error):
             return
         if length != GID_SIZE:
             return
+        # a rosl publisher keeps the ids the graph knows it by (see zenoh_identity)
+        owner = identities.owners.get(data[17:])
+        sender = low | 1 if owner is None else owner[0]
+        if owner is not None:
+            endpoint = owner[1]
         delivery = _new_tuple(Delivery, (
-            _DATA, low | 1, endpoint, seq & _MASK32, topic, type_, stamp, time_ns(),
+            _DATA, sender, endpoint, seq & _MASK32, topic, type_, stamp, time_ns(),
             memoryview(sample.payload.to_bytes()), None, 0,
         ))  # fmt: skip
         channel = channel_of(topic)
         for receiver in transport.receivers:
-            if channel in receiver.channels:
+            if channel in receiver.channels and receiver.reader.want_all is want_all:
                 receiver.put_delivery(delivery)
 
     return on_sample
@@ -145,9 +156,7 @@ class ZenohReceiver:
         for item in items:
             if type(item) is bytes:
                 datagrams.append(item)
-            else:
-                if item.kind == _DATA:
-                    count(item)
+            elif item.kind != _DATA or count(item):
                 out.append(item)
         if datagrams:
             source = iter(datagrams)
@@ -199,19 +208,21 @@ class ZenohReceiver:
                 return []
             items.append(item)
 
-    def _count(self, delivery: Delivery) -> None:
-        """Received and lost counts per publisher, as the reader keeps them for datagrams."""
+    def _count(self, delivery: Delivery) -> bool:
+        """Count a message in its publisher's stream with the multicast reader's own window.
+
+        The same received/lost/duplicate accounting as for datagrams (a gap counts as lost
+        until its messages arrive late); False for a duplicate, which is dropped.
+        """
         key = (delivery.sender, delivery.endpoint)
         stats = self.reader.streams.get(key)
         if stats is None:
-            stats = StreamStats(delivery.topic, last_seq=delivery.seq - 1)
+            stats = StreamStats(
+                delivery.topic, last_seq=(delivery.seq - 1) & _MASK32,
+                last_received=delivery.received,
+            )  # fmt: skip
             self.reader.streams[key] = stats
-        gap = delivery.seq - stats.last_seq
-        if 1 < gap <= 1 << 16:
-            stats.lost += gap - 1
-        stats.last_seq = max(stats.last_seq, delivery.seq)
-        stats.received += 1
-        stats.last_received = delivery.received
+        return count_in_window(stats, delivery.seq, delivery.stamp, delivery.received, True) <= 0
 
     def wake(self) -> None:
         """Make a blocked (or the next) :meth:`poll` return."""

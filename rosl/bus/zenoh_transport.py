@@ -62,11 +62,16 @@ class _Route:
     service: bool
 
 
+ROSL_ONLY = "rosl_msgs/"  # rosl's own control types (lock-step answers): rosl datagrams only
+
+
 def type_hash_of(type_name: str, service: bool) -> str:
-    """The RIHS01 hash of a type this process can load ("" when it cannot)."""
+    """The RIHS01 hash of a type this process can load ("" when it cannot, or rosl's own)."""
     from rosl.idl import registry
     from rosl.idl.errors import InterfaceError
 
+    if type_name.startswith(ROSL_ONLY):
+        return ""  # no ROS 2 node reads them; they keep rosl's process and endpoint ids
     try:
         if service:
             registry.get_service_class(type_name)
@@ -84,6 +89,7 @@ class ZenohTransport:
     def __init__(self, domain: int) -> None:
         from rosl.bus.zenoh_config import open_session, session_config
         from rosl.bus.zenoh_graph import ForeignGraph, LocalEntities
+        from rosl.bus.zenoh_identity import Identities
 
         self.name = "the Zenoh transport"
         self.fix_hint = (
@@ -107,7 +113,9 @@ class ZenohTransport:
         self._wildcard: Any = None  # the subscriber on every topic (recorders)
         self._queries: dict[tuple[int, int, int], tuple[Any, bytes]] = {}
         self._key_hashes: dict[str, tuple[int, int]] = {}
+        self._cached: dict[int, int] = {}  # topic -> its transient-local publishers (cached)
         self.local = LocalEntities(self)
+        self.identities = Identities(self.session, domain, self.zid)
         self._rosl_sub = self.session.declare_subscriber(
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
         )
@@ -163,27 +171,69 @@ class ZenohTransport:
                         route.key, self._on_query, complete=True
                     )
 
-    def subscribe(self, key: str) -> None:
-        """Declare a Zenoh subscriber on a data key (idempotent)."""
+    def keep_history(self, topic: int, depth: int, reliable: bool) -> None:
+        """A transient-local publisher was made (the seam's optional hook): cache on Zenoh.
+
+        Its topic's key is put through an ``AdvancedPublisher`` keeping ``depth`` samples, as
+        rmw_zenoh declares one (see :mod:`rosl.bus.zenoh_history`); late subscriptions of
+        any process, ROS 2's too, are served from it, so rosl's own replays of the topic are
+        not sent.
+        """
+        from rosl.bus.zenoh_history import declare_cached_publisher
+
         with self._lock:
-            if key not in self._subscribers and not self._closed:
-                self._subscribers[key] = self.session.declare_subscriber(
-                    key, sample_callback(self, self.key_hashes(key))
-                )
+            route = self._routes.get(topic)
+            if route is None or not route.key or self._closed:
+                return
+            self._cached[topic] = self._cached.get(topic, 0) + 1
+            if self._cached[topic] > 1:
+                return  # one cache per topic and process (the first publisher's depth)
+            old = self._publishers.pop(route.key, None)
+            self._publishers[route.key] = declare_cached_publisher(
+                self.session, route.key, depth, reliable
+            )
+        if old is not None:
+            old.undeclare()
+
+    def drop_history(self, topic: int) -> None:
+        """A transient-local publisher went: its topic's cache goes with the last of them."""
+        with self._lock:
+            count = self._cached.pop(topic, 0)
+            if count > 1:
+                self._cached[topic] = count - 1
+                return
+            route = self._routes.get(topic)
+            cached = self._publishers.pop(route.key, None) if route and count else None
+        if cached is not None and not self._closed:
+            cached.undeclare()
+
+    def subscribe(self, key: str) -> None:
+        """Declare Zenoh subscribers on a data key and its Humble form (idempotent).
+
+        ROS 2 Humble's rmw_zenoh has no type hashes: it writes ``TypeHashNotSupported`` in
+        their place, so its publishers are heard on that key too (matched by name and type).
+        """
+        with self._lock:
+            for each in (key, wire.humble_key(key)):
+                if each not in self._subscribers and not self._closed:
+                    self._subscribers[each] = self.session.declare_subscriber(
+                        each, sample_callback(self, self.key_hashes(each), False)
+                    )
 
     def unsubscribe(self, key: str) -> None:
-        """Undeclare a data key's subscriber."""
+        """Undeclare a data key's subscribers."""
         with self._lock:
-            subscriber = self._subscribers.pop(key, None)
-        if subscriber is not None:
-            subscriber.undeclare()
+            subscribers = [self._subscribers.pop(k, None) for k in (key, wire.humble_key(key))]
+        for subscriber in subscribers:
+            if subscriber is not None:
+                subscriber.undeclare()
 
     def subscribe_all(self) -> None:
         """Receive every topic of the domain (recorders and monitors)."""
         with self._lock:
             if self._wildcard is None and not self._closed:
                 self._wildcard = self.session.declare_subscriber(
-                    f"{self.domain}/**", sample_callback(self, None)
+                    f"{self.domain}/**", sample_callback(self, None, True)
                 )
 
     # --- sending --------------------------------------------------------------------------------
@@ -215,6 +265,8 @@ class ZenohTransport:
         if routed and kind in (Kind.RESPONSE, Kind.FAILURE) and flags & Flags.ADDRESSED:
             self._reply(kind, payload)
             return
+        if kind == Kind.REPLAY and topic in self._cached:
+            return  # late subscriptions query the topic's Zenoh cache instead
         try:
             self.session.put(f"{ROSL_PREFIX}/{self.domain}/{channel}", data)
         except Exception as err:  # zenoh.ZError: a closed session
@@ -321,11 +373,33 @@ class ZenohTransport:
         if not isinstance(message, dict):
             return
         if message.get("op") == "hello":
+            self.identities.announce(int(str(message["process"]["sender"]), 16))
             self.local.update(message["process"])
         elif message.get("op") == "bye":
             self.local.update(None)
         elif message.get("op") == "query":
             self.foreign.answer(f"{message['sender']}:{message['qid']}")
+        elif message.get("op") == "replay":
+            self._query_history(message)
+
+    def _query_history(self, message: dict[str, Any]) -> None:
+        """A late transient-local subscription of this process: ask the topic's caches."""
+        from rosl.bus.zenoh_history import query_history
+
+        try:
+            sender, endpoint = message["target"]
+            target = (int(str(sender), 16), int(endpoint))
+            name = str(message["topic"])
+        except (KeyError, TypeError, ValueError):
+            return
+        query_history(self, name, target)
+
+    def identity(self, gid: bytes) -> tuple[int, int]:
+        """(process, endpoint) of a GID: a rosl endpoint's own ids, else derived from it."""
+        owner = self.identities.owners.get(gid)
+        if owner is not None:
+            return owner
+        return int.from_bytes(gid[:8], "little") | 1, int.from_bytes(gid[8:10], "little")
 
     # --- receiving ------------------------------------------------------------------------------
 
@@ -379,10 +453,13 @@ class ZenohTransport:
             )
         )
 
-    def _deliver(self, delivery: Delivery) -> None:
+    def _deliver(self, delivery: Delivery, want_all: bool | None = None) -> None:
+        """Hand a delivery to the receivers of its channel (of one kind, when ``want_all``)."""
         channel = channel_of(delivery.topic)
         for receiver in self.receivers:
-            if channel in receiver.channels:
+            if channel in receiver.channels and (
+                want_all is None or receiver.reader.want_all is want_all
+            ):
                 receiver.put_delivery(delivery)
 
     # --- the seam -------------------------------------------------------------------------------
@@ -411,6 +488,8 @@ class ZenohTransport:
         for receiver in self.receivers:
             receiver.close()
         self.foreign.close()
+        with contextlib.suppress(Exception):  # a closed session undeclared them already
+            self.identities.close()
         self.local.update(None)
         with contextlib.suppress(Exception):  # closing at exit: nothing left to tell
             self.session.close()  # type: ignore[no-untyped-call]

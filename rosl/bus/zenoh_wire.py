@@ -161,6 +161,11 @@ def topic_key(domain: int, name: str, type_name: str, type_hash: str) -> str:
     return f"{domain}/{name.strip('/')}/{dds_type(type_name)}/{type_hash}"
 
 
+def humble_key(key: str) -> str:
+    """A data key as ROS 2 Humble's rmw_zenoh writes it: ``TypeHashNotSupported`` as hash."""
+    return f"{key.rsplit('/', 1)[0]}/{NO_TYPE_HASH}"
+
+
 @dataclass(frozen=True, slots=True)
 class TopicKey:
     """A data key expression, read back."""

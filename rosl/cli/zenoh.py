@@ -17,12 +17,12 @@ def command() -> None:
 @click.option(
     "--listen",
     default=None,
-    help=f"Endpoint to listen on  [default: {zenoh_config.ROUTER_LISTEN}, "
-    "or ZENOH_ROUTER_CONFIG_URI's]",
+    help=f"Endpoint to listen on (port 0: one the system picks, printed)  [default: "
+    f"{zenoh_config.ROUTER_LISTEN}, or ZENOH_ROUTER_CONFIG_URI's]",
 )
 def router(listen: str | None) -> None:
     """Run a Zenoh router until Ctrl-C (what rmw_zenohd is to ROS 2)."""
     session = zenoh_config.open_session(zenoh_config.router_config(listen))
-    where = listen or zenoh_config.router_listen_text()
+    where = zenoh_config.listening_on(session) or listen or zenoh_config.router_listen_text()
     render.lines([f"Zenoh router {session.info.zid()} listening on {where}"])
     zenoh_config.serve_forever(session)

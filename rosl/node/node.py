@@ -377,6 +377,9 @@ class Node:
             return False
         publisher.flush()
         self.participant.remove_replayer(publisher.topic, publisher)
+        drop = getattr(self.participant.transport, "drop_history", None)
+        if drop is not None and publisher.qos_profile.keeps_history:  # Zenoh's cache of it
+            drop(publisher._writer.topic)
         if publisher._writer in self.participant.writers:
             self.participant.writers.remove(publisher._writer)
         publisher._writer.close()  # its shared-memory ring, if it made one

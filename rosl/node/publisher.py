@@ -19,7 +19,7 @@ from rosl.bus.header import Kind
 from rosl.bus.wire import Writer
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
-from rosl.node.qos import MANUAL, duration_ns
+from rosl.node.qos import MANUAL, ReliabilityPolicy, duration_ns
 
 if TYPE_CHECKING:
     from rosl.idl.messages import Message
@@ -64,6 +64,10 @@ class Publisher:
         self.destroyed = False
         if self._history is not None:
             participant.add_replayer(topic, self)
+            keep = getattr(participant.transport, "keep_history", None)
+            if keep is not None:  # a transport that keeps history itself (Zenoh's caches)
+                reliable = qos.reliability is not ReliabilityPolicy.BEST_EFFORT
+                keep(self._writer.topic, max(1, qos.depth), reliable)
         # QoS events (see qos_watch): deadline, lifespan, manual-by-topic liveliness
         # (local durations: the monotonic clock, which no clock step moves)
         self.last_published_ns: int | None = None

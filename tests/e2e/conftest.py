@@ -25,15 +25,11 @@ def transport(
 ) -> str:
     """Every end-to-end test runs on both transports (Zenoh: through its own router)."""
     if request.param == "zenoh":
-        from tests.zenoh.conftest import Router, free_port
+        from tests.zenoh.conftest import Router
 
-        port = free_port()
+        router = Router(processes)
         monkeypatch.setenv("ROSL_TRANSPORT", "zenoh")
-        monkeypatch.setenv(
-            "ZENOH_CONFIG_OVERRIDE",
-            f'connect/endpoints=["tcp/127.0.0.1:{port}"];listen/endpoints=["tcp/127.0.0.1:0"]',
-        )
-        Router(processes, port)
+        monkeypatch.setenv("ZENOH_CONFIG_OVERRIDE", router.session_override)
     return str(request.param)
 
 

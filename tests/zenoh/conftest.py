@@ -1,19 +1,25 @@
-"""Fixtures for the Zenoh transport: a router on a free loopback port, rosl set to use it."""
+"""Fixtures for the Zenoh transport: a router on a loopback port, rosl set to use it.
+
+The router binds port 0 and prints the port the system gave it, so no other process can take
+the port between its choice and the bind (as with a port probed free, then bound later).
+"""
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import pytest
 
-from tests.conftest import ChildOutput, free_port, wait_until
+from tests.conftest import ChildOutput, wait_until
 
 if TYPE_CHECKING:
     from tests.conftest import Processes
 
 PEER = str(Path(__file__).with_name("peer.py"))
+ROUTER_PORT = re.compile(r"listening on (?:tcp|tls)/127\.0\.0\.1:(\d+)")  # what it was given
 
 
 def wait_output(output: ChildOutput, needle: str, timeout: float = 30.0) -> bool:
@@ -27,16 +33,23 @@ def wait_output(output: ChildOutput, needle: str, timeout: float = 30.0) -> bool
 
 
 class Router:
-    """A ``rosl zenoh router`` on a free loopback port."""
+    """A ``rosl zenoh router`` on a loopback port the system picks."""
 
-    def __init__(self, processes: Processes, port: int) -> None:
-        self.port = port
-        self.endpoint = f"tcp/127.0.0.1:{port}"
+    def __init__(self, processes: Processes) -> None:
         self.child = processes.rosl(
-            "zenoh", "router", "--listen", self.endpoint, env={"ZENOH_CONFIG_OVERRIDE": ""}
+            "zenoh", "router", "--listen", "tcp/127.0.0.1:0", env={"ZENOH_CONFIG_OVERRIDE": ""}
         )
         self.output = ChildOutput(self.child)
         assert wait_output(self.output, "listening on"), self.output.text
+        found = ROUTER_PORT.search(self.output.text["out"])
+        assert found, self.output.text
+        self.port = int(found.group(1))
+        self.endpoint = f"tcp/127.0.0.1:{self.port}"
+
+    @property
+    def session_override(self) -> str:
+        """ZENOH_CONFIG_OVERRIDE for a rosl process connecting to this router only."""
+        return f'connect/endpoints=["{self.endpoint}"];listen/endpoints=["tcp/127.0.0.1:0"]'
 
     def peer(self, processes: Processes, role: str, domain: int, *args: str) -> ChildOutput:
         """Start the plain-zenoh rmw_zenoh peer (tests/zenoh/peer.py) in ``role``."""
@@ -49,15 +62,12 @@ class Router:
 @pytest.fixture
 def router(processes: Processes, domain_id: int, monkeypatch: pytest.MonkeyPatch) -> Router:
     """A router; rosl (this process and its children) on Zenoh, connected to it."""
-    port = free_port()
-    monkeypatch.setenv("ROSL_TRANSPORT", "zenoh")
-    monkeypatch.setenv(
-        "ZENOH_CONFIG_OVERRIDE",
-        f'connect/endpoints=["tcp/127.0.0.1:{port}"];listen/endpoints=["tcp/127.0.0.1:0"]',
-    )
     monkeypatch.delenv("ZENOH_SESSION_CONFIG_URI", raising=False)
     monkeypatch.delenv("ZENOH_ROUTER_CONFIG_URI", raising=False)
-    return Router(processes, port)
+    started = Router(processes)
+    monkeypatch.setenv("ROSL_TRANSPORT", "zenoh")
+    monkeypatch.setenv("ZENOH_CONFIG_OVERRIDE", started.session_override)
+    return started
 
 
-__all__ = ["Router", "free_port", "wait_output", "wait_until"]
+__all__ = ["ROUTER_PORT", "Router", "wait_output", "wait_until"]

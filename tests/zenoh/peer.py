@@ -5,6 +5,18 @@ liveliness tokens for its node and endpoint, puts with the 33-byte attachment, C
 with their encapsulation header, services as a complete queryable answered to gets.
 
     python peer.py talker|listener|server|client PORT DOMAIN [a b]
+    python peer.py latched_talker|latched_listener PORT DOMAIN
+    python peer.py humble_talker PORT DOMAIN
+    python peer.py gappy_talker PORT DOMAIN
+
+``humble_talker`` is the talker as ROS 2 Humble's rmw_zenoh names it: ``TypeHashNotSupported``
+where the type hash goes, in its key expression and its token. ``gappy_talker`` waits for a
+subscriber, then sends sequence numbers 1, 2, 3, 6, 7 and 7 again (two lost, one duplicate).
+
+``latched_*`` are transient-local with depth 3, as rmw_zenoh declares them: the talker an
+``AdvancedPublisher`` caching 3 samples with publisher detection (it publishes
+``Latched: 1`` to ``Latched: 5`` on ``/latched`` once, then waits), the listener an
+``AdvancedSubscriber`` whose history detects late publishers.
 
 It connects to the router at tcp/127.0.0.1:PORT with multicast scouting off, and prints one
 line per thing it saw (``heard ...``, ``served ...``, ``sum ...``) for the tests to read.
@@ -24,6 +36,7 @@ STRING_HASH = "RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f
 ADD = "example_interfaces::srv::dds_::AddTwoInts_"
 ADD_HASH = "RIHS01_e118de6bf5eeb66a2491b5bda11202e7b68f198d6f67922cf30364858239c81a"
 QOS = "::,10:,:,:,,"  # reliable, volatile, keep last 10
+LATCHED_QOS = ":1:,3:,:,:,,"  # reliable, transient local, keep last 3
 CDR_LE = b"\x00\x01\x00\x00"
 
 
@@ -59,11 +72,22 @@ def main() -> None:
         "listener": "listener",
         "server": "add_two_ints_server",
         "client": "add_two_ints_client",
+        "latched_talker": "latched_talker",
+        "latched_listener": "latched_listener",
+        "humble_talker": "talker",
+        "gappy_talker": "talker",
     }[role]
     prefix = f"@ros2_lv/{domain}/{zid}/0"
     tokens = [session.liveliness().declare_token(f"{prefix}/0/NN/%/%/{node}")]
-    if role in ("talker", "listener"):
-        kind = "MP" if role == "talker" else "MS"
+    if role.startswith("latched_"):
+        kind = "MP" if role == "latched_talker" else "MS"
+        token = f"{prefix}/10/{kind}/%/%/{node}/%latched/{STRING}/{STRING_HASH}/{LATCHED_QOS}"
+        key = f"{domain}/latched/{STRING}/{STRING_HASH}"
+    elif role == "humble_talker":
+        token = f"{prefix}/10/MP/%/%/{node}/%chatter/{STRING}/TypeHashNotSupported/{QOS}"
+        key = f"{domain}/chatter/{STRING}/TypeHashNotSupported"
+    elif role in ("talker", "listener", "gappy_talker"):
+        kind = "MS" if role == "listener" else "MP"
         token = f"{prefix}/10/{kind}/%/%/{node}/%chatter/{STRING}/{STRING_HASH}/{QOS}"
         key = f"{domain}/chatter/{STRING}/{STRING_HASH}"
     else:
@@ -72,8 +96,20 @@ def main() -> None:
         key = f"{domain}/add_two_ints/{ADD}/{ADD_HASH}"
     tokens.append(session.liveliness().declare_token(token))
     me = gid(token)
+    if role.startswith("latched_"):
+        latched(session, role, key, me, zid)
+        return
     print(f"ready {zid}", flush=True)
-    if role == "talker":
+    if role == "gappy_talker":
+        publisher = session.declare_publisher(key)
+        while not publisher.matching_status:
+            time.sleep(0.05)
+        time.sleep(0.5)  # every subscriber of the router's graph has its route by now
+        for seq in (1, 2, 3, 6, 7, 7):
+            publisher.put(string_cdr(f"m{seq}"), attachment=attachment(seq, time.time_ns(), me))
+        while True:
+            time.sleep(1)
+    if role in ("talker", "humble_talker"):
         publisher = session.declare_publisher(key)
         seq = 0
         while True:
@@ -135,6 +171,37 @@ def main() -> None:
                     return
             time.sleep(0.3)
         print("no server", flush=True)
+
+
+def latched(session: zenoh.Session, role: str, key: str, me: bytes, zid: str) -> None:
+    """The transient-local roles (see the module docstring)."""
+    from zenoh import ext
+
+    if role == "latched_talker":
+        publisher = ext.declare_advanced_publisher(
+            session, key, cache=ext.CacheConfig(max_samples=3), publisher_detection=True,
+            sample_miss_detection=ext.MissDetectionConfig(heartbeat=None, sporadic_heartbeat=1.0),
+        )  # fmt: skip
+        for seq in range(1, 6):
+            publisher.put(
+                string_cdr(f"Latched: {seq}"), attachment=attachment(seq, time.time_ns(), me)
+            )
+        print(f"ready {zid}", flush=True)
+        while True:
+            time.sleep(1)
+
+    def heard(sample: zenoh.Sample) -> None:
+        if sample.attachment is not None:
+            print(f"heard {read_string(sample.payload.to_bytes())!r}", flush=True)
+
+    _subscriber = ext.declare_advanced_subscriber(  # kept until the process ends
+        session, key, heard, subscriber_detection=True,
+        history=ext.HistoryConfig(detect_late_publishers=True, max_samples=3),
+        recovery=ext.RecoveryConfig(heartbeat=True),
+    )  # fmt: skip
+    print(f"ready {zid}", flush=True)
+    while True:
+        time.sleep(1)
 
 
 if __name__ == "__main__":

@@ -1,15 +1,16 @@
-"""Zenoh settings as rmw_zenoh users give them: config files, overrides, domains, user/password.
+"""Zenoh settings as rmw_zenoh users give them: config files, overrides, domains.
+
+(User/password and TLS: test_auth.py.)
 
 Every router listens on a free loopback port; every session connects to it only.
 """
 
 from __future__ import annotations
 
-import json
 from typing import TYPE_CHECKING
 
 from tests.conftest import ChildOutput, Processes
-from tests.zenoh.conftest import free_port, wait_output
+from tests.zenoh.conftest import wait_output
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -39,58 +40,6 @@ def test_ros_domain_id_partitions_one_router(
     out, err = other.communicate(timeout=60)
     assert other.returncode == 0, err
     assert "/partitioned" not in out
-
-
-def test_user_and_password_from_config_files_keep_strangers_out(
-    processes: Processes, domain_id: int, tmp_path: Path
-) -> None:
-    port = free_port()
-    (tmp_path / "users.txt").write_text("robot:s3cret\n")
-    router_file = tmp_path / "router.json5"
-    router_file.write_text(json.dumps({
-        "mode": "router",
-        "listen": {"endpoints": [f"tcp/127.0.0.1:{port}"]},
-        "scouting": {"multicast": {"enabled": False}},
-        "transport": {"auth": {"usrpwd": {"dictionary_file": str(tmp_path / "users.txt")}}},
-    }))  # fmt: skip
-    router = processes.rosl(
-        "zenoh", "router",
-        env={"ZENOH_ROUTER_CONFIG_URI": str(router_file), "ZENOH_CONFIG_OVERRIDE": ""},
-    )  # fmt: skip
-    assert wait_output(ChildOutput(router), f"the endpoints of {router_file}")
-
-    def session(password: str) -> dict[str, str]:
-        path = tmp_path / f"session-{password}.json5"
-        path.write_text(json.dumps({
-            "mode": "peer",
-            "connect": {"endpoints": [f"tcp/127.0.0.1:{port}"]},
-            "listen": {"endpoints": ["tcp/127.0.0.1:0"]},
-            "scouting": {"multicast": {"enabled": False}},
-            "transport": {"auth": {"usrpwd": {  # peers link directly: each checks the other
-                "user": "robot", "password": password,
-                "dictionary_file": str(tmp_path / "users.txt"),
-            }}},
-        }))  # fmt: skip
-        return {"ROSL_TRANSPORT": "zenoh", "ZENOH_SESSION_CONFIG_URI": str(path),
-                "ZENOH_CONFIG_OVERRIDE": ""}  # fmt: skip
-
-    _pub(processes, "/guarded", session("s3cret"))
-    # rosl's session takes its credentials from the file: the router admits the right ones
-    # (a rosl process that cannot link to the router sees nobody; the session's own view)
-    code = (
-        "import time; from rosl.bus.zenoh_transport import ZenohTransport; "
-        "t = ZenohTransport(0); deadline = time.monotonic() + 20\n"
-        "while not t.session.info.routers_zid() and time.monotonic() < deadline:\n"
-        "    time.sleep(0.05)\n"
-        "print('linked' if t.session.info.routers_zid() else 'alone'); t.close()"
-    )
-    friend = processes.python(code, env=session("s3cret"))
-    stranger = processes.python(code, env=session("wrong"))
-    assert friend.communicate(timeout=60)[0].split() == ["linked"]
-    assert stranger.communicate(timeout=60)[0].split() == ["alone"]
-    listing = processes.rosl("topic", "list", env=session("wrong"))
-    out, err = listing.communicate(timeout=60)
-    assert "/guarded" not in out, (out, err)
 
 
 def test_a_bad_override_is_one_line_naming_it(processes: Processes, domain_id: int) -> None:

@@ -39,10 +39,8 @@ def test_a_rosl_node_hears_the_peer_talker_and_the_peer_hears_rosl(
     assert re.search(r"heard 'from rosl' seq=\d+ gidlen=16 size=33", listener.text["out"])
 
 
-def test_rosl_cli_echo_list_and_node_list_see_the_peer(
-    router: Router, processes: Processes, domain_id: int
-) -> None:
-    router.peer(processes, "talker", domain_id)
+def _echo_and_list_chatter(processes: Processes) -> None:
+    """``rosl topic echo --once`` prints the peer talker's message; ``topic list`` shows it."""
     echo = processes.rosl("topic", "echo", "/chatter", "--once")
     out, err = echo.communicate(timeout=60)
     assert echo.returncode == 0, err
@@ -50,6 +48,13 @@ def test_rosl_cli_echo_list_and_node_list_see_the_peer(
     listing = processes.rosl("topic", "list", "-t")
     out, err = listing.communicate(timeout=60)
     assert "/chatter [std_msgs/msg/String]" in out, (out, err)
+
+
+def test_rosl_cli_echo_list_and_node_list_see_the_peer(
+    router: Router, processes: Processes, domain_id: int
+) -> None:
+    router.peer(processes, "talker", domain_id)
+    _echo_and_list_chatter(processes)
     nodes = processes.rosl("node", "list")
     out, err = nodes.communicate(timeout=60)
     assert "/talker" in out.split(), (out, err)
@@ -144,3 +149,50 @@ def router_peer_path() -> str:
     from tests.zenoh.conftest import PEER
 
     return PEER
+
+
+def test_a_humble_peer_without_type_hashes_is_heard_by_name_and_type(
+    router: Router, processes: Processes, domain_id: int, ros: object
+) -> None:
+    from std_msgs.msg import String
+
+    import rosl
+
+    router.peer(processes, "humble_talker", domain_id)
+    node = rosl.create_node("rosl_listener")
+    heard: list[str] = []
+    node.create_subscription(String, "/chatter", lambda m: heard.append(m.data), 10)
+
+    def received() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return any(h.startswith("Hello World") for h in heard)
+
+    assert wait_until(received, 30), heard
+    _echo_and_list_chatter(processes)
+
+
+def test_a_gap_in_the_peers_sequence_numbers_is_counted_lost_and_a_duplicate_dropped(
+    router: Router, processes: Processes, domain_id: int, ros: object
+) -> None:
+    from std_msgs.msg import String
+
+    import rosl
+
+    node = rosl.create_node("rosl_listener")
+    heard: list[str] = []
+    subscription = node.create_subscription(String, "/chatter", lambda m: heard.append(m.data), 10)
+    router.peer(processes, "gappy_talker", domain_id)
+
+    def received() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return "m7" in heard
+
+    assert wait_until(received, 30), heard
+
+    def spun() -> bool:
+        rosl.spin_once(node, timeout_sec=0.1)
+        return False
+
+    wait_until(spun, 1.0)  # a second m7 would be taken by now
+    assert heard == ["m1", "m2", "m3", "m6", "m7"]
+    assert subscription.lost == 2

@@ -191,3 +191,9 @@ def test_dds_type_names_round_trip() -> None:
 def test_data_keys_read_back() -> None:
     key = wire.parse_topic_key(f"0/robot1/chatter/std_msgs::msg::dds_::String_/{STRING}")
     assert key == wire.TopicKey(0, "/robot1/chatter", "std_msgs/msg/String", STRING)
+
+
+def test_a_humble_key_has_type_hash_not_supported_in_place_of_the_hash() -> None:
+    key = wire.topic_key(0, "/chatter", "std_msgs/msg/String", "RIHS01_" + "ab" * 32)
+    assert wire.humble_key(key) == "0/chatter/std_msgs::msg::dds_::String_/TypeHashNotSupported"
+    assert wire.parse_topic_key(wire.humble_key(key)).type == "std_msgs/msg/String"
