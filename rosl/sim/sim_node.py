@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import SUBSCRIPTION
+from rosl.sim import encode
 from rosl.sim import messages as build
 from rosl.sim.report import RobotReport, SimReport
 from rosl.sim.simulation import Schedule
@@ -255,8 +256,10 @@ class SimNode:
         clock = self._clock_schedule
         if now >= clock.at_ns:
             clock.fire(now)
+        sec, nanosec = divmod(now, NS)  # one stamp for the tick's messages
         sampled = False
-        transforms: list[build.Transform] = []
+        frames: tuple[tuple[bytes, bytes], ...] = ()  # the /tf message's transforms
+        values: list[object] = []  # and their values, each robot's added by its encoder
         for topics in self.robots:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
@@ -266,27 +269,32 @@ class SimNode:
                 if not sampled:
                     sim.sample()
                     sampled = True
-                state = sim_robot.robot.odometry()
-                if topics.odom.wanted():
-                    topics.odom.send(encoder.odometry(now, state))
-                transforms.append(encoder.odom_transform(state))
+                topic = topics.odom
+                wanted = topic.always or topic.wanted()
+                message = encoder.odometry_at(sec, nanosec, values, wanted)
+                if wanted:
+                    topic.send(message)
+                frames += encoder.odom_key
             joints = sim_robot.joints
             if joints is not None and now >= joints.at_ns:
                 joints.fire(now)
-                if topics.joints is not None and topics.joints.wanted():
-                    topics.joints.send(encoder.joint_states(now))
-                transforms += encoder.wheel_transforms()
+                topic_or_none = topics.joints
+                if topic_or_none is not None and (topic_or_none.always or topic_or_none.wanted()):
+                    topic_or_none.send(encoder.joint_states_at(sec, nanosec))
+                encoder.wheels_at(sec, nanosec, values)
+                frames += encoder.wheel_key
             for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
                 if now >= schedule.at_ns:
                     index = schedule.fire(now)
-                    wanted = topic.wanted()
+                    wanted = topic.always or topic.wanted()
                     if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if wanted:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
-        if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
-            self.tf.send(build.tf_bytes(transforms, now))
-        self.clock.send(build.clock_bytes(now))  # with every step's data, and at clock_rate
+        tf = self.tf
+        if frames and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
+            tf.send(encode.tf_struct(frames).pack(encode.HEADER, len(frames), *values))
+        self.clock.send(encode.CLOCK.pack(encode.HEADER, sec, nanosec))  # every step's data too
         self._next_event = min([schedule.at_ns for schedule in self._schedules])
 
     # --- running -----------------------------------------------------------------------------
@@ -350,7 +358,7 @@ class SimNode:
 
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
         """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
-        sim, tick, step = self.sim, self.tick, self.sim.step
+        sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
         end = math.inf if end_ns is None else end_ns
@@ -370,10 +378,16 @@ class SimNode:
             now = sim.now_ns
             if now >= end:
                 return
-            if started + (now + sim.step_ns) / scale > wall:
+            allowed = (wall - started) * scale - step_ns  # the last start the pace allows now
+            if now > allowed:
                 self._pace(started)
-            step()
-            if sim.now_ns >= self._next_event:  # most steps publish nothing: no call
+                step()
+            else:  # the steps that publish nothing run back to back, the clock unread
+                stop = min(self._next_event, end)
+                step()
+                while sim.now_ns < stop and sim.now_ns <= allowed:
+                    step()
+            if sim.now_ns >= self._next_event:
                 tick()
 
     def _flush(self) -> None:
