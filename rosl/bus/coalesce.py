@@ -33,7 +33,7 @@ class Batch:
     """The pending small messages of one writer."""
 
     def __init__(
-        self, send: Callable[[int, int, bytes], None], limit: int, flusher: Flusher
+        self, send: Callable[[int, int, bytearray], None], limit: int, flusher: Flusher
     ) -> None:
         self.limit = limit
         self._send = send  # (first seq, first stamp, records) -> one datagram
@@ -56,10 +56,13 @@ class Batch:
             if not timed:  # the flusher has closed: nothing would send it later
                 self._flush_locked()
 
-    def add_all(self, first_seq: int, stamp: int, payloads: list[bytes]) -> None:
+    def add_all(
+        self, first_seq: int, stamp: int, payloads: list[bytes], flush: bool = False
+    ) -> None:
         """Append messages numbered ``first_seq`` on, in order, each small enough to fit.
 
-        What :meth:`add` does for each, in one loop under one lock.
+        What :meth:`add` does for each, in one loop under one lock; with ``flush``, then what
+        :meth:`flush` does, under the same lock.
         """
         pack, size, limit = RECORD.pack, RECORD.size, self.limit
         with self._lock:
@@ -71,7 +74,7 @@ class Batch:
                 records = self._records
                 records += pack((first_seq + offset) & 0xFFFFFFFF, stamp, len(payload))
                 records += payload
-            if not timed:  # the flusher has closed: nothing would send it later
+            if flush or not timed:  # asked, or the flusher has closed: nothing would send it
                 self._flush_locked()
 
     def flush(self) -> None:
@@ -83,7 +86,7 @@ class Batch:
         if not self._records:
             return
         seq, stamp, _ = RECORD.unpack_from(self._records)
-        records, self._records = bytes(self._records), bytearray()
+        records, self._records = self._records, bytearray()  # handed over: never changed again
         self._send(seq, stamp, records)
 
 

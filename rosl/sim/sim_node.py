@@ -84,9 +84,8 @@ class _Topic:
         """Publish what waits as the publisher's batch, and send it (its only messages)."""
         pending = self._pending
         if pending:
-            self.publisher.publish_all(pending)
+            self.publisher.publish_all(pending, flush=True)
             pending.clear()
-            self.publisher.flush()
 
 
 @dataclass(slots=True)
