@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import struct
 import threading
+from itertools import chain, repeat
 from typing import TYPE_CHECKING
 
 from rosl.errors import RoslError
@@ -65,8 +66,17 @@ class Batch:
         :meth:`flush` does, under the same lock.
         """
         pack, size, limit = RECORD.pack, RECORD.size, self.limit
+        count = len(payloads)
+        sizes = list(map(len, payloads))
         with self._lock:
             timed = bool(self._records) or self._flusher.due(self)
+            if (
+                len(self._records) + size * count + sum(sizes) <= limit
+                and first_seq + count <= 0x100000000
+            ):  # all fit, no number wraps: the records are built with no Python loop
+                heads = map(pack, range(first_seq, first_seq + count), repeat(stamp), sizes)
+                self._records += b"".join(chain.from_iterable(zip(heads, payloads, strict=True)))
+                payloads = []
             for offset, payload in enumerate(payloads):
                 if len(self._records) + size + len(payload) > limit:
                     self._flush_locked()

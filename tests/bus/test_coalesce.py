@@ -171,18 +171,19 @@ def test_send_all_with_flush_sends_at_once_what_fits_in_one_datagram(domain_id: 
     counted = Counted(domain_id, delay_s=60.0)
     try:
         writer = counted.bus.writer
-        payloads = [payload_of(64, seed=n) for n in range(20)]
+        writer.send(b"first")  # waits in the batch: the others join it
+        payloads = [payload_of(64 + n, seed=n) for n in range(20)]
         writer.send_all(payloads, flush=True)
-        got = counted.bus.collector.wait_count(20, timeout=20.0)
-        assert [bytes(d.payload) for d in got] == payloads
-        assert [d.seq for d in got] == list(range(1, 21))
+        got = counted.bus.collector.wait_count(21, timeout=20.0)
+        assert [bytes(d.payload) for d in got] == [b"first", *payloads]
+        assert [d.seq for d in got] == list(range(1, 22))
         writer.send_all([payload_of(200_000, seed=9), b"after"], flush=True)  # too big: sends
-        got = counted.bus.collector.wait_count(22, timeout=20.0)
-        assert [bytes(d.payload) for d in got[20:]] == [payload_of(200_000, seed=9), b"after"]
+        got = counted.bus.collector.wait_count(23, timeout=20.0)
+        assert [bytes(d.payload) for d in got[21:]] == [payload_of(200_000, seed=9), b"after"]
         batches = batched_records(
             [d for d in counted.datagrams() if HEADER.unpack_from(d)[3] & Flags.BATCH]
         )
-        assert [[r[0] for r in b] for b in batches] == [list(range(1, 21)), [22]]
+        assert [[r[0] for r in b] for b in batches] == [list(range(1, 22)), [23]]
     finally:
         counted.close()
 
