@@ -328,10 +328,12 @@ class RobotEncoder:
             if frame.joint is not None
         ]  # fmt: skip
         self.wheel_key = tuple((parent, child) for parent, child, *_ in self.wheels)
+        turning = len(sim_robot.robot.wheels)  # the joints the robot turns (the others: 0)
         self._wheel_heads = [
-            ((len(parent) + 1, parent, len(child) + 1, child, *xyz), rotation, joint)
+            ((len(parent) + 1, parent, len(child) + 1, child, *xyz), rotation,
+             joint if joint is not None and joint < turning else None)
             for parent, child, xyz, rotation, joint in self.wheels
-        ]
+        ]  # fmt: skip
         self.scans = {
             lidar: (lidar.frame_id.encode(),
                     (lidar.angle_min, lidar.angle_max, lidar_cast.increment(lidar), 0.0,
@@ -398,8 +400,7 @@ class RobotEncoder:
         """
         angles = self.sim_robot.robot.wheels
         for head, (ax, ay, az, aw), joint in self._wheel_heads:
-            spin = 0.0 if joint is None or joint >= len(angles) else angles[joint]
-            if spin:
+            if joint is not None and (spin := angles[joint]):
                 bz, bw = math.sin(spin / 2), math.cos(spin / 2)
                 tf += (
                     sec, nanosec, *head,

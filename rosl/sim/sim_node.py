@@ -25,10 +25,11 @@ recording keep one datagram per message and serve the bus every step.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import SUBSCRIPTION
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
     from rosl.node.publisher import Publisher
     from rosl.sim.options import SimOptions
     from rosl.sim.simulation import SimRobot, Simulation
+    from rosl.sim.worldfile import Lidar
 
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
@@ -96,6 +98,9 @@ class _RobotTopics:
     scans: list[_Topic]
     description: Publisher
     encoder: build.RobotEncoder
+    lidars: list[tuple[Lidar, Schedule, _Topic]] = field(default_factory=list)
+    odom_key: int = 0  # this robot's odometry transform in a tick's /tf (see SimNode._tf_pack)
+    wheel_key: int = 0  # and its wheels'
 
 
 class SimNode:
@@ -197,11 +202,15 @@ class SimNode:
             description = node.create_publisher(
                 build.msg("std_msgs/msg/String"), f"{prefix}/robot_description", latched
             )
-            self.robots.append(
-                _RobotTopics(
-                    sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
-                )
+            topics = _RobotTopics(
+                sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
             )
+            topics.lidars = [
+                (lidar, s, t) for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
+            ]
+            topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
+            self.robots.append(topics)
+        self._tf_packs: dict[tuple[int, ...], Callable[..., bytes]] = {}
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -257,7 +266,7 @@ class SimNode:
             clock.fire(now)
         sec, nanosec = divmod(now, NS)  # one stamp for the tick's messages
         sampled = False
-        frames: tuple[tuple[bytes, bytes], ...] = ()  # the /tf message's transforms
+        key: tuple[int, ...] = ()  # the transforms in the /tf message (see _tf_pack)
         values: list[object] = []  # and their values, each robot's added by its encoder
         for topics in self.robots:
             sim_robot = topics.sim_robot
@@ -273,7 +282,7 @@ class SimNode:
                 message = encoder.odometry_at(sec, nanosec, values, wanted)
                 if wanted:
                     topic.send(message)
-                frames += encoder.odom_key
+                key += (topics.odom_key,)
             joints = sim_robot.joints
             if joints is not None and now >= joints.at_ns:
                 joints.fire(now)
@@ -281,8 +290,8 @@ class SimNode:
                 if topic_or_none is not None and (topic_or_none.always or topic_or_none.wanted()):
                     topic_or_none.send(encoder.joint_states_at(sec, nanosec))
                 encoder.wheels_at(sec, nanosec, values)
-                frames += encoder.wheel_key
-            for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
+                key += (topics.wheel_key,)
+            for lidar, schedule, topic in topics.lidars:
                 if now >= schedule.at_ns:
                     index = schedule.fire(now)
                     wanted = topic.always or topic.wanted()
@@ -291,10 +300,24 @@ class SimNode:
                         if wanted:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
         tf = self.tf
-        if frames and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
-            tf.send(encode.tf_struct(frames).pack(encode.HEADER, len(frames), *values))
+        if key and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
+            pack = self._tf_packs.get(key) or self._tf_pack(key)
+            tf.send(pack(*values))
         self.clock.send(encode.CLOCK.pack(encode.HEADER, sec, nanosec))  # every step's data too
         self._next_event = min([schedule.at_ns for schedule in self._schedules])
+
+    def _tf_pack(self, key: tuple[int, ...]) -> Callable[..., bytes]:
+        """The packer of /tf of these robots' odometry (2 k) and wheels (2 k + 1) transforms.
+
+        It takes the transforms' values: the header and the count are bound.
+        """
+        frames: tuple[tuple[bytes, bytes], ...] = ()
+        for part in key:
+            encoder = self.robots[part // 2].encoder
+            frames += encoder.wheel_key if part % 2 else encoder.odom_key
+        pack = functools.partial(encode.tf_struct(frames).pack, encode.HEADER, len(frames))
+        self._tf_packs[key] = pack
+        return pack
 
     # --- running -----------------------------------------------------------------------------
 
