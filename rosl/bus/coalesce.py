@@ -34,7 +34,7 @@ class Batch:
     """The pending small messages of one writer."""
 
     def __init__(
-        self, send: Callable[[int, int, bytearray], None], limit: int, flusher: Flusher
+        self, send: Callable[[int, int, bytes | bytearray], None], limit: int, flusher: Flusher
     ) -> None:
         self.limit = limit
         self._send = send  # (first seq, first stamp, records) -> one datagram
@@ -69,14 +69,20 @@ class Batch:
         count = len(payloads)
         sizes = list(map(len, payloads))
         with self._lock:
-            timed = bool(self._records) or self._flusher.due(self)
             if (
                 len(self._records) + size * count + sum(sizes) <= limit
                 and first_seq + count <= 0x100000000
             ):  # all fit, no number wraps: the records are built with no Python loop
                 heads = map(pack, range(first_seq, first_seq + count), repeat(stamp), sizes)
-                self._records += b"".join(chain.from_iterable(zip(heads, payloads, strict=True)))
+                joined = b"".join(chain.from_iterable(zip(heads, payloads, strict=True)))
+                if flush and not self._records:  # the batch is these alone: it goes as it is
+                    self._send(first_seq, stamp, joined)
+                    return
+                timed = bool(self._records) or self._flusher.due(self)
+                self._records += joined
                 payloads = []
+            else:
+                timed = bool(self._records) or self._flusher.due(self)
             for offset, payload in enumerate(payloads):
                 if len(self._records) + size + len(payload) > limit:
                     self._flush_locked()

@@ -254,7 +254,7 @@ class Writer:
         if self.batch is not None:
             self.batch.flush()
 
-    def _send_batch(self, seq: int, stamp: int, records: bytearray) -> None:
+    def _send_batch(self, seq: int, stamp: int, records: bytes | bytearray) -> None:
         head = HEADER.pack(
             _MAGIC, _VERSION, self.kind, _BATCH | self._signed, 1, self.sender, seq,
             self.topic, self.type, 0, self.endpoint, len(records), stamp,

@@ -286,6 +286,11 @@ def urdf(model: RobotModel) -> str:
 
 # --- the same messages as CDR bytes (the sim's hot path; see encode.py) ------------------------
 
+_STAMP_INTO = struct.Struct("<iI").pack_into
+_POSE_INTO = struct.Struct("<dd24xdd").pack_into  # x, y, (z, qx, qy: 0), qz, qw
+_TWIST_INTO = struct.Struct("<d32xd").pack_into  # linear x, (4 zeros), angular z
+_ODOM_TWIST = 7 * 8 + 36 * 8  # from the pose to the twist: the pose, its covariance
+_ODOM_TAIL = _ODOM_TWIST + 6 * 8 + 36 * 8  # from the pose to the end
 _COVARIANCE = tuple(POSE_COVARIANCE[k // 7] if k % 7 == 0 else 0.0 for k in range(36))
 
 
@@ -317,6 +322,14 @@ class RobotEncoder:
         self._frames = (len(self.odom_frame) + 1, self.odom_frame,
                         len(self.base_frame) + 1, self.base_frame)  # fmt: skip
         self.odom_key = ((self.odom_frame, self.base_frame),)
+        # a message of zeros with the frames and covariances in place: a tick writes the stamp,
+        # the pose's x, y, qz, qw and the twist's forward and turn speeds into it and copies it
+        pose = encode.odometry_struct(self.odom_frame, self.base_frame).size - _ODOM_TAIL
+        self._odometry_buffer = bytearray(self._odometry(
+            encode.HEADER, 0, 0, *self._frames, *[0.0] * 7, self._covariance, *[0.0] * 6,
+            self._covariance,
+        ))  # fmt: skip
+        self._odometry_offsets = (pose, pose + _ODOM_TWIST)
         self.joint_names = [j.encode() for j in model.joints]
         self._joints = encode.joint_struct(tuple(self.joint_names)).pack
         self._names = tuple(v for name in self.joint_names for v in (len(name) + 1, name))
@@ -362,15 +375,15 @@ class RobotEncoder:
         (x, y, yaw), (forward, turn) = self.sim_robot.robot.odometry()
         half = yaw / 2  # quaternion(0, 0, yaw)
         qz, qw = math.sin(half), math.cos(half)
-        frames = self._frames
-        tf += (sec, nanosec, *frames, x, y, 0.0, 0.0, 0.0, qz, qw)
+        tf += (sec, nanosec, *self._frames, x, y, 0.0, 0.0, 0.0, qz, qw)
         if not message:
             return b""
-        covariance = self._covariance
-        return self._odometry(
-            encode.HEADER, sec, nanosec, *frames, x, y, 0.0, 0.0, 0.0, qz, qw, covariance,
-            forward, 0.0, 0.0, 0.0, 0.0, turn, covariance,
-        )  # fmt: skip
+        buffer = self._odometry_buffer
+        pose, twist = self._odometry_offsets
+        _STAMP_INTO(buffer, 4, sec, nanosec)  # after the encapsulation header
+        _POSE_INTO(buffer, pose, x, y, qz, qw)
+        _TWIST_INTO(buffer, twist, forward, turn)
+        return bytes(buffer)
 
     def odom_transform(self, odom: tuple[tuple[float, float, float], object]) -> Transform:
         """``odom -> base_footprint`` of ``odom`` (the robot's :meth:`odometry`)."""

@@ -180,10 +180,14 @@ def test_send_all_with_flush_sends_at_once_what_fits_in_one_datagram(domain_id: 
         writer.send_all([payload_of(200_000, seed=9), b"after"], flush=True)  # too big: sends
         got = counted.bus.collector.wait_count(23, timeout=20.0)
         assert [bytes(d.payload) for d in got[21:]] == [payload_of(200_000, seed=9), b"after"]
+        writer.send_all([b"x", b"y"], flush=True)  # nothing pending: these alone, at once
+        got = counted.bus.collector.wait_count(25, timeout=20.0)
+        assert [(bytes(d.payload), d.seq) for d in got[23:]] == [(b"x", 24), (b"y", 25)]
         batches = batched_records(
             [d for d in counted.datagrams() if HEADER.unpack_from(d)[3] & Flags.BATCH]
         )
-        assert [[r[0] for r in b] for b in batches] == [list(range(1, 22)), [23]]
+        assert [[r[0] for r in b] for b in batches] == [list(range(1, 22)), [23], [24, 25]]
+        assert (writer.sent, writer.last_seq) == (25, 25)
     finally:
         counted.close()
 
