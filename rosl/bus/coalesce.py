@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import struct
 import threading
+from itertools import chain, repeat
 from typing import TYPE_CHECKING
 
 from rosl.errors import RoslError
@@ -33,7 +34,7 @@ class Batch:
     """The pending small messages of one writer."""
 
     def __init__(
-        self, send: Callable[[int, int, bytes], None], limit: int, flusher: Flusher
+        self, send: Callable[[int, int, bytes | bytearray], None], limit: int, flusher: Flusher
     ) -> None:
         self.limit = limit
         self._send = send  # (first seq, first stamp, records) -> one datagram
@@ -56,14 +57,32 @@ class Batch:
             if not timed:  # the flusher has closed: nothing would send it later
                 self._flush_locked()
 
-    def add_all(self, first_seq: int, stamp: int, payloads: list[bytes]) -> None:
+    def add_all(
+        self, first_seq: int, stamp: int, payloads: list[bytes], flush: bool = False
+    ) -> None:
         """Append messages numbered ``first_seq`` on, in order, each small enough to fit.
 
-        What :meth:`add` does for each, in one loop under one lock.
+        What :meth:`add` does for each, in one loop under one lock; with ``flush``, then what
+        :meth:`flush` does, under the same lock.
         """
         pack, size, limit = RECORD.pack, RECORD.size, self.limit
+        count = len(payloads)
+        sizes = list(map(len, payloads))
         with self._lock:
-            timed = bool(self._records) or self._flusher.due(self)
+            if (
+                len(self._records) + size * count + sum(sizes) <= limit
+                and first_seq + count <= 0x100000000
+            ):  # all fit, no number wraps: the records are built with no Python loop
+                heads = map(pack, range(first_seq, first_seq + count), repeat(stamp), sizes)
+                joined = b"".join(chain.from_iterable(zip(heads, payloads, strict=True)))
+                if flush and not self._records:  # the batch is these alone: it goes as it is
+                    self._send(first_seq, stamp, joined)
+                    return
+                timed = bool(self._records) or self._flusher.due(self)
+                self._records += joined
+                payloads = []
+            else:
+                timed = bool(self._records) or self._flusher.due(self)
             for offset, payload in enumerate(payloads):
                 if len(self._records) + size + len(payload) > limit:
                     self._flush_locked()
@@ -71,7 +90,7 @@ class Batch:
                 records = self._records
                 records += pack((first_seq + offset) & 0xFFFFFFFF, stamp, len(payload))
                 records += payload
-            if not timed:  # the flusher has closed: nothing would send it later
+            if flush or not timed:  # asked, or the flusher has closed: nothing would send it
                 self._flush_locked()
 
     def flush(self) -> None:
@@ -83,7 +102,7 @@ class Batch:
         if not self._records:
             return
         seq, stamp, _ = RECORD.unpack_from(self._records)
-        records, self._records = bytes(self._records), bytearray()
+        records, self._records = self._records, bytearray()  # handed over: never changed again
         self._send(seq, stamp, records)
 
 

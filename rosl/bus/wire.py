@@ -259,7 +259,7 @@ class Writer:
         if self.batch is not None:
             self.batch.flush()
 
-    def _send_batch(self, seq: int, stamp: int, records: bytes) -> None:
+    def _send_batch(self, seq: int, stamp: int, records: bytes | bytearray) -> None:
         head = HEADER.pack(
             _MAGIC, _VERSION, self.kind, _BATCH | self._signed, 1, self.sender, seq,
             self.topic, self.type, 0, self.endpoint, len(records), stamp,
@@ -354,26 +354,24 @@ class Writer:
             self.last_seq = number
         return number
 
-    def send_all(self, payloads: list[bytes]) -> None:
+    def send_all(self, payloads: list[bytes], flush: bool = False) -> None:
         """Send plain messages in order, stamped now: a batching writer adds them in one loop.
 
         The same as :meth:`send` for each (numbers, counts, batches), without its options'
         per-message cost; a message too big for a batch, or a writer that does not batch,
-        goes through :meth:`send`.
+        goes through :meth:`send`. With ``flush``, then :meth:`flush`.
         """
         batch = self.batch
-        if batch is None or self.flags:
-            for payload in payloads:
+        if batch is None or self.flags or not batch.fits(max(map(len, payloads), default=0)):
+            for payload in payloads:  # (a big one keeps its place)
                 self.send(payload)
-            return
-        if not batch.fits(max(map(len, payloads), default=0)):  # a big one keeps its place
-            for payload in payloads:
-                self.send(payload)
+            if flush:
+                self.flush()
             return
         first = next(self._seq)
         count = len(payloads)
         self._seq = itertools.count(first + count)
-        batch.add_all(first, time.time_ns(), payloads)
+        batch.add_all(first, time.time_ns(), payloads, flush)
         self.sent += count
         self.last_seq = (first + count - 1) & 0xFFFFFFFF
 

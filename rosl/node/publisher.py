@@ -100,19 +100,21 @@ class Publisher:
         if self._history is not None:
             self._history.append((seq, now, data))
 
-    def publish_all(self, payloads: list[bytes]) -> None:
+    def publish_all(self, payloads: list[bytes], flush: bool = False) -> None:
         """Send already-serialized messages in order, as :meth:`publish` each would.
 
         For a caller that queues its own messages between flushes: a batching publisher adds
-        them in one loop rather than one call each.
+        them in one loop rather than one call each; with ``flush``, then :meth:`flush`.
         """
         if not payloads:
             return
         if self._history is not None or self._manual:  # each needs its own record
             for payload in payloads:
                 self.publish(payload)
+            if flush:
+                self.flush()
             return
-        self._writer.send_all(payloads)
+        self._writer.send_all(payloads, flush)
         self.last_published_ns = time.time_ns()
 
     def replay(self, target: tuple[int, int]) -> None:

@@ -18,7 +18,7 @@ from functools import cache
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Sequence
+    from collections.abc import Sequence
 
     import numpy as np
 
@@ -58,26 +58,26 @@ def _split_secs(now_ns: int) -> tuple[int, int]:
     return divmod(now_ns, NS)
 
 
-_CLOCK = struct.Struct("<4siI")
+CLOCK = struct.Struct("<4siI")  # header, sec, nanosec
 
 
 def clock(now_ns: int) -> bytes:
     """rosgraph_msgs/msg/Clock."""
     sec, nanosec = _split_secs(now_ns)
-    return _CLOCK.pack(HEADER, sec, nanosec)
+    return CLOCK.pack(HEADER, sec, nanosec)
 
 
-_TWIST = struct.Struct("<6d")
+COVARIANCE_SIZE = 36 * 8
 
 
 @cache
-def odometry_packer(
-    frame: bytes, child: bytes, covariance: tuple[float, ...]
-) -> Callable[[int, Sequence[float], Sequence[float]], bytes]:
-    """A function packing nav_msgs/msg/Odometry of (now_ns, pose, twist) for fixed frames.
+def odometry_struct(frame: bytes, child: bytes) -> struct.Struct:
+    """nav_msgs/msg/Odometry for fixed frames as one format.
 
-    The header and the pose are one ``pack``; the covariance (the same for the pose and the
-    twist) is packed here once; the doubles are contiguous, so the parts only join.
+    Its values: the encapsulation header, sec, nanosec, the two frames (each its size with
+    the NUL, then the bytes), the pose (7 doubles), the pose covariance (288 packed bytes),
+    the twist (6 doubles) and the twist covariance (288 bytes): the doubles are contiguous
+    from the 8-aligned pose on, so no padding follows it.
     """
     layout = _Layout()
     layout.format += "4s"  # the encapsulation header (not counted in offsets)
@@ -85,17 +85,8 @@ def odometry_packer(
     layout.field("I", 4)
     layout.string(frame)
     layout.string(child)
-    layout.field("d", 8, 7)  # the pose: 8-aligned and 56 bytes, so the rest needs no padding
-    pack_head, pack_twist = layout.struct().pack, _TWIST.pack
-    packed_covariance = struct.pack("<36d", *covariance)
-    frame_size, child_size = len(frame) + 1, len(child) + 1
-
-    def pack(now_ns: int, pose: Sequence[float], twist: Sequence[float]) -> bytes:
-        sec, nanosec = divmod(now_ns, NS)
-        head = pack_head(HEADER, sec, nanosec, frame_size, frame, child_size, child, *pose)
-        return b"".join((head, packed_covariance, pack_twist(*twist), packed_covariance))
-
-    return pack
+    layout.field("d", 8, 7)
+    return struct.Struct(f"{layout.format}{COVARIANCE_SIZE}s6d{COVARIANCE_SIZE}s")
 
 
 def odometry(now_ns: int, frame: bytes, child: bytes, pose: Sequence[float],
@@ -105,11 +96,21 @@ def odometry(now_ns: int, frame: bytes, child: bytes, pose: Sequence[float],
     ``pose`` is x, y, z, qx, qy, qz, qw; ``twist`` 6 values; the same 36 ``covariance``
     values go with the pose and the twist.
     """
-    return odometry_packer(frame, child, tuple(covariance))(now_ns, pose, twist)
+    sec, nanosec = divmod(now_ns, NS)
+    packed = struct.pack("<36d", *covariance)
+    return odometry_struct(frame, child).pack(
+        HEADER, sec, nanosec, len(frame) + 1, frame, len(child) + 1, child, *pose, packed,
+        *twist, packed,
+    )  # fmt: skip
 
 
 @cache
-def _tf_layout(frames: tuple[tuple[bytes, bytes], ...]) -> struct.Struct:
+def tf_struct(frames: tuple[tuple[bytes, bytes], ...]) -> struct.Struct:
+    """tf2_msgs/msg/TFMessage of transforms between these (parent, child) frames.
+
+    Its values: the encapsulation header, the count, then per transform sec, nanosec, the
+    parent's size and bytes, the child's, and 7 doubles (x, y, z, qx, qy, qz, qw).
+    """
     layout = _Layout()
     layout.format += "4s"
     layout.field("I", 4)
@@ -128,11 +129,16 @@ def tf_message(now_ns: int, transforms: Sequence[tuple[bytes, bytes, Sequence[fl
     values: list[object] = [HEADER, len(transforms)]
     for parent, child, numbers in transforms:
         values += [sec, nanosec, len(parent) + 1, parent, len(child) + 1, child, *numbers]
-    return _tf_layout(tuple((p, c) for p, c, _ in transforms)).pack(*values)
+    return tf_struct(tuple((p, c) for p, c, _ in transforms)).pack(*values)
 
 
 @cache
-def _joint_layout(names: tuple[bytes, ...]) -> struct.Struct:
+def joint_struct(names: tuple[bytes, ...]) -> struct.Struct:
+    """sensor_msgs/msg/JointState of these joints, an empty frame and no efforts.
+
+    Its values: the encapsulation header, sec, nanosec, 1, b"", the count, each name's size
+    and bytes, then the positions and the velocities (each its count, then the doubles), 0.
+    """
     layout = _Layout()
     layout.format += "4s"
     layout.field("i", 4)
@@ -157,7 +163,7 @@ def joint_state(now_ns: int, names: Sequence[bytes], position: Sequence[float],
     for name in names:
         values += [len(name) + 1, name]
     values += [len(position), *position, len(velocity), *velocity, 0]
-    return _joint_layout(tuple(names)).pack(*values)
+    return joint_struct(tuple(names)).pack(*values)
 
 
 @cache

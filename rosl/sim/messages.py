@@ -10,6 +10,7 @@ robot's odometry frame at its spawn pose.
 from __future__ import annotations
 
 import math
+import struct
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
@@ -285,6 +286,11 @@ def urdf(model: RobotModel) -> str:
 
 # --- the same messages as CDR bytes (the sim's hot path; see encode.py) ------------------------
 
+_STAMP_INTO = struct.Struct("<iI").pack_into
+_POSE_INTO = struct.Struct("<dd24xdd").pack_into  # x, y, (z, qx, qy: 0), qz, qw
+_TWIST_INTO = struct.Struct("<d32xd").pack_into  # linear x, (4 zeros), angular z
+_ODOM_TWIST = 7 * 8 + 36 * 8  # from the pose to the twist: the pose, its covariance
+_ODOM_TAIL = _ODOM_TWIST + 6 * 8 + 36 * 8  # from the pose to the end
 _COVARIANCE = tuple(POSE_COVARIANCE[k // 7] if k % 7 == 0 else 0.0 for k in range(36))
 
 
@@ -300,7 +306,10 @@ class RobotEncoder:
     """One robot's high-rate messages as CDR, with what is fixed about them prepared once.
 
     Frame names are encoded, the wheel links' fixed rotations and the scans' constant fields
-    computed at construction; a message then costs its moving numbers and one ``pack``.
+    computed at construction; a message then costs its moving numbers and one ``pack``. The
+    ``*_at`` methods serve the sim node's tick: they take the stamp split once for all of a
+    tick's messages and add their transforms' values to the tick's one ``/tf`` message (for
+    :func:`rosl.sim.encode.tf_struct` of the frames they add to the key).
     """
 
     def __init__(self, sim_robot: SimRobot) -> None:
@@ -308,14 +317,35 @@ class RobotEncoder:
         model = sim_robot.robot.spec.model
         self.odom_frame = model.odom_frame.encode()
         self.base_frame = model.base_frame.encode()
-        self._pack_odometry = encode.odometry_packer(self.odom_frame, self.base_frame, _COVARIANCE)
+        self._odometry = encode.odometry_struct(self.odom_frame, self.base_frame).pack
+        self._covariance = struct.pack("<36d", *_COVARIANCE)
+        self._frames = (len(self.odom_frame) + 1, self.odom_frame,
+                        len(self.base_frame) + 1, self.base_frame)  # fmt: skip
+        self.odom_key = ((self.odom_frame, self.base_frame),)
+        # a message of zeros with the frames and covariances in place: a tick writes the stamp,
+        # the pose's x, y, qz, qw and the twist's forward and turn speeds into it and copies it
+        pose = encode.odometry_struct(self.odom_frame, self.base_frame).size - _ODOM_TAIL
+        self._odometry_buffer = bytearray(self._odometry(
+            encode.HEADER, 0, 0, *self._frames, *[0.0] * 7, self._covariance, *[0.0] * 6,
+            self._covariance,
+        ))  # fmt: skip
+        self._odometry_offsets = (pose, pose + _ODOM_TWIST)
         self.joint_names = [j.encode() for j in model.joints]
+        self._joints = encode.joint_struct(tuple(self.joint_names)).pack
+        self._names = tuple(v for name in self.joint_names for v in (len(name) + 1, name))
         index = {joint: k for k, joint in enumerate(model.joints)}
         self.wheels = [
             (frame.parent.encode(), frame.name.encode(), frame.xyz, quaternion(*frame.rpy),
              index.get(frame.joint))
             for frame in model.frames
             if frame.joint is not None
+        ]  # fmt: skip
+        self.wheel_key = tuple((parent, child) for parent, child, *_ in self.wheels)
+        turning = len(sim_robot.robot.wheels)  # the joints the robot turns (the others: 0)
+        self._wheel_heads = [
+            ((len(parent) + 1, parent, len(child) + 1, child, *xyz), rotation,
+             joint if joint is not None and joint < turning else None)
+            for parent, child, xyz, rotation, joint in self.wheels
         ]  # fmt: skip
         self.scans = {
             lidar: (lidar.frame_id.encode(),
@@ -329,11 +359,31 @@ class RobotEncoder:
     ) -> bytes:
         """nav_msgs/Odometry of ``odom`` (the robot's :meth:`odometry`) as CDR."""
         (x, y, yaw), (forward, turn) = odom
-        return self._pack_odometry(
-            now_ns,
-            (x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)),
-            (forward, 0.0, 0.0, 0.0, 0.0, turn),
-        )
+        sec, nanosec = divmod(now_ns, NS)
+        covariance = self._covariance
+        return self._odometry(
+            encode.HEADER, sec, nanosec, *self._frames,
+            x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2), covariance,
+            forward, 0.0, 0.0, 0.0, 0.0, turn, covariance,
+        )  # fmt: skip
+
+    def odometry_at(self, sec: int, nanosec: int, tf: list[object], message: bool) -> bytes:
+        """The robot's odometry now as nav_msgs/Odometry CDR (b"" unless ``message``).
+
+        Its ``odom -> base`` transform's values are added to ``tf``.
+        """
+        (x, y, yaw), (forward, turn) = self.sim_robot.robot.odometry()
+        half = yaw / 2  # quaternion(0, 0, yaw)
+        qz, qw = math.sin(half), math.cos(half)
+        tf += (sec, nanosec, *self._frames, x, y, 0.0, 0.0, 0.0, qz, qw)
+        if not message:
+            return b""
+        buffer = self._odometry_buffer
+        pose, twist = self._odometry_offsets
+        _STAMP_INTO(buffer, 4, sec, nanosec)  # after the encapsulation header
+        _POSE_INTO(buffer, pose, x, y, qz, qw)
+        _TWIST_INTO(buffer, twist, forward, turn)
+        return bytes(buffer)
 
     def odom_transform(self, odom: tuple[tuple[float, float, float], object]) -> Transform:
         """``odom -> base_footprint`` of ``odom`` (the robot's :meth:`odometry`)."""
@@ -355,13 +405,39 @@ class RobotEncoder:
             transforms.append((parent, child, (*xyz, *rotation)))
         return transforms
 
+    def wheels_at(self, sec: int, nanosec: int, tf: list[object]) -> None:
+        """The wheel links turned by their joints: their transforms' values added to ``tf``.
+
+        The same numbers as :meth:`wheel_transforms` (its quaternion product, written out
+        for a turn about z, with the same operations in the same order).
+        """
+        angles = self.sim_robot.robot.wheels
+        for head, (ax, ay, az, aw), joint in self._wheel_heads:
+            if joint is not None and (spin := angles[joint]):
+                bz, bw = math.sin(spin / 2), math.cos(spin / 2)
+                tf += (
+                    sec, nanosec, *head,
+                    aw * 0.0 + ax * bw + ay * bz - az * 0.0,
+                    aw * 0.0 - ax * bz + ay * bw + az * 0.0,
+                    aw * bz + ax * 0.0 - ay * 0.0 + az * bw,
+                    aw * bw - ax * 0.0 - ay * 0.0 - az * bz,
+                )  # fmt: skip
+            else:
+                tf += (sec, nanosec, *head, ax, ay, az, aw)
+
     def joint_states(self, now_ns: int) -> bytes:
         """sensor_msgs/JointState of the wheels as CDR."""
+        return self.joint_states_at(*divmod(now_ns, NS))
+
+    def joint_states_at(self, sec: int, nanosec: int) -> bytes:
+        """sensor_msgs/JointState of the wheels as CDR, stamped ``sec``, ``nanosec``."""
         robot = self.sim_robot.robot
         count = len(self.joint_names)
-        return encode.joint_state(
-            now_ns, self.joint_names, robot.wheels[:count], robot.wheel_rates[:count]
-        )
+        position, velocity = robot.wheels[:count], robot.wheel_rates[:count]
+        return self._joints(
+            encode.HEADER, sec, nanosec, 1, b"", count, *self._names,
+            len(position), *position, len(velocity), *velocity, 0,
+        )  # fmt: skip
 
     def laser_scan(self, lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:
         """sensor_msgs/LaserScan of one of the robot's LiDARs as CDR."""

@@ -25,13 +25,15 @@ recording keep one datagram per message and serve the bus every step.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from rosl.graph.records import SUBSCRIPTION
+from rosl.sim import encode
 from rosl.sim import messages as build
 from rosl.sim.report import RobotReport, SimReport
 from rosl.sim.simulation import Schedule
@@ -46,6 +48,7 @@ if TYPE_CHECKING:
     from rosl.node.publisher import Publisher
     from rosl.sim.options import SimOptions
     from rosl.sim.simulation import SimRobot, Simulation
+    from rosl.sim.worldfile import Lidar
 
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
@@ -83,9 +86,8 @@ class _Topic:
         """Publish what waits as the publisher's batch, and send it (its only messages)."""
         pending = self._pending
         if pending:
-            self.publisher.publish_all(pending)
+            self.publisher.publish_all(pending, flush=True)
             pending.clear()
-            self.publisher.flush()
 
 
 @dataclass(slots=True)
@@ -96,6 +98,9 @@ class _RobotTopics:
     scans: list[_Topic]
     description: Publisher
     encoder: build.RobotEncoder
+    lidars: list[tuple[Lidar, Schedule, _Topic]] = field(default_factory=list)
+    odom_key: int = 0  # this robot's odometry transform in a tick's /tf (see SimNode._tf_pack)
+    wheel_key: int = 0  # and its wheels'
 
 
 class SimNode:
@@ -197,11 +202,15 @@ class SimNode:
             description = node.create_publisher(
                 build.msg("std_msgs/msg/String"), f"{prefix}/robot_description", latched
             )
-            self.robots.append(
-                _RobotTopics(
-                    sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
-                )
+            topics = _RobotTopics(
+                sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
             )
+            topics.lidars = [
+                (lidar, s, t) for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
+            ]
+            topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
+            self.robots.append(topics)
+        self._tf_packs: dict[tuple[int, ...], Callable[..., bytes]] = {}
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -255,8 +264,10 @@ class SimNode:
         clock = self._clock_schedule
         if now >= clock.at_ns:
             clock.fire(now)
+        sec, nanosec = divmod(now, NS)  # one stamp for the tick's messages
         sampled = False
-        transforms: list[build.Transform] = []
+        key: tuple[int, ...] = ()  # the transforms in the /tf message (see _tf_pack)
+        values: list[object] = []  # and their values, each robot's added by its encoder
         for topics in self.robots:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
@@ -266,28 +277,47 @@ class SimNode:
                 if not sampled:
                     sim.sample()
                     sampled = True
-                state = sim_robot.robot.odometry()
-                if topics.odom.wanted():
-                    topics.odom.send(encoder.odometry(now, state))
-                transforms.append(encoder.odom_transform(state))
+                topic = topics.odom
+                wanted = topic.always or topic.wanted()
+                message = encoder.odometry_at(sec, nanosec, values, wanted)
+                if wanted:
+                    topic.send(message)
+                key += (topics.odom_key,)
             joints = sim_robot.joints
             if joints is not None and now >= joints.at_ns:
                 joints.fire(now)
-                if topics.joints is not None and topics.joints.wanted():
-                    topics.joints.send(encoder.joint_states(now))
-                transforms += encoder.wheel_transforms()
-            for (lidar, schedule), topic in zip(sim_robot.lidars, topics.scans, strict=True):
+                topic_or_none = topics.joints
+                if topic_or_none is not None and (topic_or_none.always or topic_or_none.wanted()):
+                    topic_or_none.send(encoder.joint_states_at(sec, nanosec))
+                encoder.wheels_at(sec, nanosec, values)
+                key += (topics.wheel_key,)
+            for lidar, schedule, topic in topics.lidars:
                 if now >= schedule.at_ns:
                     index = schedule.fire(now)
-                    wanted = topic.wanted()
+                    wanted = topic.always or topic.wanted()
                     if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if wanted:
                             topic.send(encoder.laser_scan(lidar, ranges, now))
-        if transforms and self.tf.wanted():  # one /tf message per tick, as a broadcaster would
-            self.tf.send(build.tf_bytes(transforms, now))
-        self.clock.send(build.clock_bytes(now))  # with every step's data, and at clock_rate
+        tf = self.tf
+        if key and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
+            pack = self._tf_packs.get(key) or self._tf_pack(key)
+            tf.send(pack(*values))
+        self.clock.send(encode.CLOCK.pack(encode.HEADER, sec, nanosec))  # every step's data too
         self._next_event = min([schedule.at_ns for schedule in self._schedules])
+
+    def _tf_pack(self, key: tuple[int, ...]) -> Callable[..., bytes]:
+        """The packer of /tf of these robots' odometry (2 k) and wheels (2 k + 1) transforms.
+
+        It takes the transforms' values: the header and the count are bound.
+        """
+        frames: tuple[tuple[bytes, bytes], ...] = ()
+        for part in key:
+            encoder = self.robots[part // 2].encoder
+            frames += encoder.wheel_key if part % 2 else encoder.odom_key
+        pack = functools.partial(encode.tf_struct(frames).pack, encode.HEADER, len(frames))
+        self._tf_packs[key] = pack
+        return pack
 
     # --- running -----------------------------------------------------------------------------
 
@@ -350,7 +380,7 @@ class SimNode:
 
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
         """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
-        sim, tick, step = self.sim, self.tick, self.sim.step
+        sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
         end = math.inf if end_ns is None else end_ns
@@ -370,10 +400,16 @@ class SimNode:
             now = sim.now_ns
             if now >= end:
                 return
-            if started + (now + sim.step_ns) / scale > wall:
+            allowed = (wall - started) * scale - step_ns  # the last start the pace allows now
+            if now > allowed:
                 self._pace(started)
-            step()
-            if sim.now_ns >= self._next_event:  # most steps publish nothing: no call
+                step()
+            else:  # the steps that publish nothing run back to back, the clock unread
+                stop = min(self._next_event, end)
+                step()
+                while sim.now_ns < stop and sim.now_ns <= allowed:
+                    step()
+            if sim.now_ns >= self._next_event:
                 tick()
 
     def _flush(self) -> None:

@@ -166,6 +166,32 @@ def test_send_all_numbers_batches_and_bounds_like_one_send_each(domain_id: int) 
         counted.close()
 
 
+def test_send_all_with_flush_sends_at_once_what_fits_in_one_datagram(domain_id: int) -> None:
+    # the flusher would wait a minute: with flush=True the batch goes out in the same call
+    counted = Counted(domain_id, delay_s=60.0)
+    try:
+        writer = counted.bus.writer
+        writer.send(b"first")  # waits in the batch: the others join it
+        payloads = [payload_of(64 + n, seed=n) for n in range(20)]
+        writer.send_all(payloads, flush=True)
+        got = counted.bus.collector.wait_count(21, timeout=20.0)
+        assert [bytes(d.payload) for d in got] == [b"first", *payloads]
+        assert [d.seq for d in got] == list(range(1, 22))
+        writer.send_all([payload_of(200_000, seed=9), b"after"], flush=True)  # too big: sends
+        got = counted.bus.collector.wait_count(23, timeout=20.0)
+        assert [bytes(d.payload) for d in got[21:]] == [payload_of(200_000, seed=9), b"after"]
+        writer.send_all([b"x", b"y"], flush=True)  # nothing pending: these alone, at once
+        got = counted.bus.collector.wait_count(25, timeout=20.0)
+        assert [(bytes(d.payload), d.seq) for d in got[23:]] == [(b"x", 24), (b"y", 25)]
+        batches = batched_records(
+            [d for d in counted.datagrams() if HEADER.unpack_from(d)[3] & Flags.BATCH]
+        )
+        assert [[r[0] for r in b] for b in batches] == [list(range(1, 22)), [23], [24, 25]]
+        assert (writer.sent, writer.last_seq) == (25, 25)
+    finally:
+        counted.close()
+
+
 def test_gaps_inside_batches_are_counted_as_lost(counted: Counted) -> None:
     for seq in (1, 2, 5, 6, 9):
         counted.bus.writer.send(b"m", seq=seq)

@@ -73,3 +73,39 @@ def test_a_scan_with_infinities_and_nan_round_trips():
     assert decoded.header.frame_id == "base_scan"
     np.testing.assert_array_equal(decoded.ranges, ranges)
     assert len(decoded.intensities) == 0
+
+
+@pytest.mark.parametrize("world_name", ["turtlebot3_world", "dolly_field"])
+def test_the_sim_nodes_tick_packs_what_the_message_objects_serialize_to(world_name):
+    # the tick's path: one stamp split once, odometry and the wheels adding their transforms
+    # to one /tf message (odom first, then the wheels), joint states from the split stamp
+    store = registry.store()
+    tf_class = registry.get_message_class("tf2_msgs/msg/TFMessage")
+    sim = Simulation(load_world(resolve_world(world_name)))
+    robot = sim.robots[0]
+    encoder = build.RobotEncoder(robot)
+    rng = np.random.default_rng(11)
+    for k in range(6):
+        robot.robot.command(float(rng.uniform(-0.2, 0.2)), float(rng.uniform(-1.0, 1.0)))
+        for _ in range(int(rng.integers(5, 60))):
+            sim.step()
+        now = sim.now_ns + k * 10**9
+        sec, nanosec = divmod(now, 10**9)
+        values: list[object] = []
+        odometry = encoder.odometry_at(sec, nanosec, values, True)
+        assert store.serialize(build.odometry(robot, now)) == odometry
+        assert encoder.odometry_at(sec, nanosec, [], False) == b""
+        frames = encoder.odom_key
+        transforms = list(build.odom_tf(robot, now).transforms)
+        wheels = build.wheel_tf(robot, now)
+        if wheels is not None:
+            encoder.wheels_at(sec, nanosec, values)
+            frames += encoder.wheel_key
+            transforms += wheels.transforms
+            joints = encoder.joint_states_at(sec, nanosec)
+            assert store.serialize(build.joint_states(robot, now)) == joints
+        packed = encode.tf_struct(frames).pack(encode.HEADER, len(frames), *values)
+        assert store.serialize(tf_class(transforms=transforms)) == packed
+        assert packed == build.tf_bytes(
+            [encoder.odom_transform(robot.robot.odometry()), *encoder.wheel_transforms()], now
+        )
