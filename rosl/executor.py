@@ -20,16 +20,15 @@ the future completes, not by polling.
 
 from __future__ import annotations
 
-import functools
-import inspect
 import os
 import signal
 import threading
 import time
 from collections import deque
+from types import CoroutineType
 from typing import TYPE_CHECKING, Any
 
-from rosl.node.callback_groups import held_groups
+from rosl.node.callback_groups import MutuallyExclusiveCallbackGroup, held_groups
 from rosl.node.task import Future, Task, current_task
 
 if TYPE_CHECKING:
@@ -146,7 +145,9 @@ class Executor:
 
     def wake(self) -> None:
         """Make a waiting ``wait_for_ready_callbacks`` look again (something changed)."""
-        self._context.wake_executors()
+        participant = self._context.participant  # (Context.wake_executors, one call less:
+        if participant is not None:  # twice per callback)
+            participant.notify()
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         """Stop spinning and wait for running callbacks; False if they outlast the timeout."""
@@ -201,8 +202,8 @@ class Executor:
         """
         forever = timeout_sec is None or timeout_sec < 0
         deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
+        remaining = None if forever else timeout_sec
         while True:
-            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
             try:
                 item, node = self._next_work(remaining)
             except ExternalShutdownException:
@@ -213,6 +214,7 @@ class Executor:
             self._run(item, node)
             if not item._internal:
                 return  # rosl's own housekeeping does not count as the one callback
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
 
     def _after_external_shutdown(self) -> None:
         """``spin_once`` after the context was shut down: return once, then end the loop.
@@ -288,7 +290,7 @@ class Executor:
             return
         assert node is not None
         result = self._execute(item, node)
-        if inspect.iscoroutine(result):  # a coroutine callback: go on as a task
+        if isinstance(result, CoroutineType):  # a coroutine callback: go on as a task
             task: Task[Any] = Task(_given, (result,), executor=self)
             task.entity, task.node = item, node
             task()
@@ -342,6 +344,7 @@ class Executor:
         batch = self._batch
         context = self._context
         waited = False
+        quiet = None  # the participant's `changes` when a wait ended at its timeout
         while True:
             if self._is_shutdown:
                 raise ShutdownException
@@ -366,7 +369,16 @@ class Executor:
                 participant = None
             changes = None if participant is None else participant.changes
             chosen = self._nodes if only is None else only
-            if self._collect(chosen, batch):
+            if changes is not None and changes == quiet:
+                # the wait timed out with nothing changed: only time moved (all else that
+                # becomes ready or runnable says so through participant.notify()), so the
+                # first due timer is the one to run; the next call looks at the rest
+                for node in chosen:
+                    for timer in node.timers:
+                        if timer._ready() and self.can_execute(timer):
+                            timer._executor_event = True  # not offered again until taken
+                            return timer, node
+            elif self._collect(chosen, batch):
                 continue
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None and remaining <= 0 and waited:
@@ -380,16 +392,8 @@ class Executor:
             if participant is None:
                 time.sleep(0.05 if wait is None else min(wait, 0.05))
                 continue
-            participant.wait(functools.partial(self._wait_ready, chosen, condition), wait, changes)
-
-    def _wait_ready(self, nodes: tuple[Node, ...], condition: Callable[[], bool] | None) -> bool:
-        """Whether the wait in :meth:`_next_work` may end (asked at its deadline)."""
-        return (
-            not self._running()
-            or bool(self._ready_tasks)
-            or (condition is not None and condition())
-            or self._collect(nodes, None)
-        )
+            # ends on any change since `changes` was read, or at `wait`: then this loop looks
+            quiet = None if participant.wait(_never, wait, changes) else changes
 
     def _collect(
         self, nodes: tuple[Node, ...], into: deque[tuple[Any, Node | None]] | None
@@ -460,7 +464,8 @@ class Executor:
                 work = entity._take()
             finally:
                 entity._executor_event = False
-                self.wake()  # it may be offered again (a reentrant group)
+                if not isinstance(group, MutuallyExclusiveCallbackGroup):
+                    self.wake()  # it may be offered again (else: the group is free at _end)
             if work is None:
                 self._end(entity, group)
                 return None
@@ -484,7 +489,7 @@ class Executor:
             raise
         finally:
             inside.depth -= 1
-        if inspect.iscoroutine(result):
+        if isinstance(result, CoroutineType):
             return self._finish(result, entity, node, group)
         self._end(entity, group)
         return result
@@ -539,6 +544,11 @@ class Executor:
 
 def _given(value: Any) -> Any:
     return value
+
+
+def _never() -> bool:
+    """The ``ready`` of a participant wait given ``since`` (it is not asked)."""
+    return False
 
 
 class SingleThreadedExecutor(Executor):

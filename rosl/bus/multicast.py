@@ -296,12 +296,22 @@ class MulticastReceiver:
         self._closed = False
         self.backlog_ns = backlog_from_env()
         self._caught_up: dict[int, int] = {}  # socket fd -> when stale messages were skipped
+        # what a poll of every channel watches, rebuilt when a channel opens or closes (not
+        # per poll: a 1 kHz timer polls a thousand times a second)
+        self._watched: list[socket.socket | int] = [self._wake_read]
+        self._channels: dict[int, int] = {}  # id(socket) -> channel
+
+    def _rewatch(self) -> None:
+        """Rebuild the every-channel watch list (under ``_lock``)."""
+        self._watched = [*self._sockets.values(), self._wake_read]
+        self._channels = {id(sock): number for number, sock in self._sockets.items()}
 
     def join(self, channel: int) -> None:
         """Open the channel's socket (joining its group) unless it is open."""
         with self._lock:
             if channel not in self._sockets and not self._closed:
                 self._sockets[channel] = open_receiver(self.addressing, channel)
+                self._rewatch()
 
     def leave(self, channel: int) -> None:
         """Close the channel's socket (leaving its group)."""
@@ -309,6 +319,7 @@ class MulticastReceiver:
             sock = self._sockets.pop(channel, None)
             if sock is not None:
                 self._caught_up.pop(sock.fileno(), None)
+                self._rewatch()
         if sock is not None:
             sock.close()
 
@@ -327,11 +338,11 @@ class MulticastReceiver:
             if self._closed:
                 return 0
             if channel is None:
-                watched: list[socket.socket | int] = [*self._sockets.values(), self._wake_read]
+                watched = self._watched  # replaced, never changed in place
             else:
                 sock = self._sockets.get(channel)
                 watched = [] if sock is None else [sock]
-            channels = {id(sock): number for number, sock in self._sockets.items()}
+            channels = self._channels
         if not watched:
             return 0
         try:
@@ -390,6 +401,7 @@ class MulticastReceiver:
                 return
             self._closed = True
             sockets, self._sockets = list(self._sockets.values()), {}
+            self._rewatch()
         self.wake()
         for sock in sockets:
             sock.close()

@@ -231,7 +231,8 @@ class Participant:
         until it has dispatched): a single-threaded executor reads its own deliveries, with
         no thread hand-off. With ``since`` (a :attr:`changes` value read before the caller
         looked for work), it returns True as soon as anything changed since then — a
-        dispatch or a :meth:`notify` — and leaves the looking to the caller.
+        dispatch or a :meth:`notify` — or False at the timeout, and leaves the looking to the
+        caller (``ready`` is not called then: a look per wake-up is the caller's).
         """
         deadline = None if timeout is None else time.monotonic() + max(0.0, timeout)
         first = True
@@ -246,7 +247,7 @@ class Participant:
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None:
                 if remaining <= 0 and not first:
-                    return ready()
+                    return False if since is not None else ready()
                 remaining = max(0.0, remaining)
             first = False
             if not self.closed and self._poll_lock.acquire(blocking=False):

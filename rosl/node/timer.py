@@ -143,17 +143,21 @@ class Timer(Executable):
         if self.callback is not None:
             self.callback()
 
-    def _ready(self) -> bool:
-        return self.is_ready()
+    def _ready(self) -> bool:  # is_ready, one call less: executors ask every look
+        return not self._canceled and self.clock.now_ns() >= self._next_call_ns
 
     def _take(self) -> Callable[[], Any] | None:
-        if not self.is_ready() or self.destroyed:
+        if self._canceled or self.destroyed:
             return None
-        self._advance()
+        now = self.clock.now_ns()
+        if now < self._next_call_ns:
+            return None
+        self._advance(now)
         return self.callback
 
-    def _advance(self) -> None:
-        now = self.clock.now_ns()
+    def _advance(self, now: int | None = None) -> None:
+        if now is None:
+            now = self.clock.now_ns()
         self._last_call_ns = now
         self._next_call_ns += self._period_ns
         if self._next_call_ns <= now:

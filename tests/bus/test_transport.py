@@ -119,6 +119,23 @@ def test_after_leave_a_channel_delivers_nothing(transport: Transport) -> None:
     assert got == []
 
 
+def test_a_channel_joined_between_polls_is_watched_by_the_next_poll(transport: Transport) -> None:
+    first, second = writer(transport, "/seam"), writer(transport, "/other_seam")
+    assert first.channel != second.channel
+    receiver = transport.receiver()
+    receiver.reader.want_all = True
+    receiver.join(first.channel)
+    first.send(b"on the first")
+    assert [bytes(d.payload) for d in collect(receiver, 1)] == [b"on the first"]
+    receiver.join(second.channel)  # after polls that watched only the first channel
+    second.send(b"on the second")
+    assert [bytes(d.payload) for d in collect(receiver, 1)] == [b"on the second"]
+    receiver.leave(first.channel)
+    first.send(b"left")
+    second.send(b"still joined")
+    assert [bytes(d.payload) for d in collect(receiver, 1)] == [b"still joined"]
+
+
 def test_wake_ends_a_poll_that_waits_without_a_timeout(transport: Transport) -> None:
     receiver = transport.receiver()
     receiver.join(1)

@@ -873,6 +873,73 @@ def test_a_waitable_made_ready_by_another_thread_runs(ros):
     assert [letter for letter, _ in box.read] == ["first", "second", "third"]
 
 
+def test_a_fast_timer_between_its_ticks_lets_guards_waitables_and_messages_through(ros):
+    # between two ticks of a fast timer the executor looks at the timers alone when nothing
+    # else announced a change: a guard, a waitable and messages must announce theirs
+    node, executor = settled(ros, "busy_ticker")
+    ticks: list[int] = []
+    node.create_timer(0.001, lambda: ticks.append(1))
+    guarded: list[int] = []
+    guard = node.create_guard_condition(lambda: guarded.append(1))
+    box = Mailbox(None)
+    node.add_waitable(box)
+    from rosl.idl.registry import get_message_class
+
+    String = get_message_class("std_msgs/msg/String")
+    heard: list[str] = []
+    node.create_subscription(String, "/between_ticks", lambda m: heard.append(m.data), 100)
+    talker = node.create_publisher(String, "/between_ticks", 100)
+    assert spin_until(executor, lambda: len(ticks) >= 20)
+    threading.Thread(target=guard.trigger, daemon=True).start()
+    threading.Thread(target=box.post, args=("letter",), daemon=True).start()
+    assert spin_until(executor, lambda: bool(guarded) and bool(box.read)), (guarded, box.read)
+    for i in range(5):
+        threading.Thread(target=talker.publish, args=(String(data=f"m{i}"),)).start()
+        assert spin_until(executor, lambda i=i: len(heard) > i), heard
+    assert sorted(heard) == [f"m{i}" for i in range(5)]
+    before = len(ticks)
+    assert spin_until(executor, lambda: len(ticks) >= before + 20)  # it still ticks
+
+
+def test_a_guard_triggered_while_spin_once_waits_for_a_distant_timer_runs_first(ros):
+    # the wait ends at the change, and the look after it is not the timers-only one
+    node, executor = settled(ros, "distant_timer")
+    ticks: list[int] = []
+    node.create_timer(3 * BOUND, lambda: ticks.append(1))
+    guarded: list[str] = []
+    guard = node.create_guard_condition(lambda: guarded.append(threading.current_thread().name))
+    for round_ in range(3):  # also after waits that ended at a timeout (spin_once(0.05))
+        spinning = threading.Thread(target=executor.spin_once, name="spinner", daemon=True)
+        spinning.start()
+        spinning.join(0.2)
+        assert spinning.is_alive(), "spin_once(timeout_sec=None) returned with nothing ready"
+        threading.Thread(target=guard.trigger, daemon=True).start()
+        spinning.join(BOUND)
+        assert not spinning.is_alive(), "the trigger did not get the guard run before the timer"
+        assert guarded == ["spinner"] * (round_ + 1)
+        executor.spin_once(timeout_sec=0.05)
+    assert ticks == []
+
+
+def test_a_wait_given_a_change_count_ends_false_at_its_timeout_without_asking_ready(ros):
+    participant = ros.Node("waiter").participant
+    asked: list[int] = []
+
+    def ready() -> bool:
+        asked.append(1)
+        return True
+
+    # (discovery may change something meanwhile: then that wait ends True; most end quiet)
+    ends = [participant.wait(ready, 0.02, participant.changes) for _ in range(20)]
+    assert False in ends
+    since = participant.changes
+    participant.notify()
+    assert participant.wait(ready, BOUND, since) is True
+    assert asked == [], "the caller looks itself when it passes `since`"
+    assert participant.wait(ready, 0.02) is True
+    assert asked, "without `since` the wait asks ready()"
+
+
 # --- 10. rclpy's submodules after `import rclpy` ---------------------------------------------
 
 SUBMODULES_SCRIPT = """
