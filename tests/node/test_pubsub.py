@@ -407,6 +407,34 @@ def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(r
     child.expect("^heard: after$")
 
 
+def test_a_held_publisher_with_a_bigger_batch_bound_sends_over_16_kb_at_the_flush(ros, spawn):
+    # the simulator holds ~17 KB of odometry per flush: above the default 16 KB bound, which
+    # would send part of it before the flush; with a 60 KB bound it all waits for the flush
+    from std_msgs.msg import String
+
+    from rosl.idl import registry
+
+    child = spawn(ECHO)  # prints what it hears on "ping"
+    child.expect("^ready$")
+    node = ros.Node("big_holder")
+    pub = node.create_publisher(String, "ping", 10)
+    assert spin_until(node, lambda: pub.get_subscription_count() > 0, 20.0)
+    pub.publish(String(data="probe"))
+    child.expect("^heard: probe$")
+    pub.hold_until_flush(60000)
+    store = registry.store()
+    count = 8  # 8 x 3 KB: 24 KB, over the default bound
+    pub.publish_all(
+        [bytes(store.serialize(String(data=f"big {k} " + "x" * 3000))) for k in range(count)]
+    )
+    spin_for(node, 0.5)
+    assert child.count("^heard: big") == 0  # nothing went before the flush
+    pub.flush()
+    for k in range(count):
+        child.expect(f"^heard: big {k} x{{3000}}$")
+    assert pub.record().stats["sent"] == count + 1
+
+
 @pytest.mark.parametrize("held", [True, False], ids=["held", "plain"])
 def test_publish_all_sends_serialized_messages_in_order_as_publish_would(ros, spawn, held):
     from std_msgs.msg import String
