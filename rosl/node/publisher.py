@@ -148,13 +148,14 @@ class Publisher:
         """Send the messages a coalescing publisher still holds (a no-op otherwise)."""
         self._writer.flush()
 
-    def hold_until_flush(self) -> None:
+    def hold_until_flush(self, limit: int = DEFAULT_BYTES) -> None:
         """Batch small messages until :meth:`flush` (or a full batch); no timer sends them.
 
         For a caller that flushes on its own schedule from its own thread: no second thread
-        wakes every millisecond to contend for the GIL.
+        wakes every millisecond to contend for the GIL. ``limit``: a batch's payload bound in
+        bytes (at most what one datagram carries).
         """
-        self._writer.coalesce(_HeldByCaller(), DEFAULT_BYTES)
+        self._writer.coalesce(_HeldByCaller(), limit)
 
     def destroy(self) -> None:
         """Stop publishing (rclpy: node.destroy_publisher)."""

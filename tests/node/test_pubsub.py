@@ -382,16 +382,24 @@ def test_a_coalescing_publisher_delivers_every_message_in_order(ros, spawn):
     assert node.subscriptions[0].lost == 0
 
 
-def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(ros, spawn):
+def _echoed_publisher(ros, spawn, name):
+    """A child echoing "ping", a node ``name`` publishing on it, a first message heard."""
     from std_msgs.msg import String
 
     child = spawn(ECHO)  # prints what it hears on "ping"
     child.expect("^ready$")
-    node = ros.Node("holder")
+    node = ros.Node(name)
     pub = node.create_publisher(String, "ping", 10)
     assert spin_until(node, lambda: pub.get_subscription_count() > 0, 20.0)
     pub.publish(String(data="probe"))  # a sent message: the child hears this one
     child.expect("^heard: probe$")
+    return child, node, pub
+
+
+def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(ros, spawn):
+    from std_msgs.msg import String
+
+    child, node, pub = _echoed_publisher(ros, spawn, "holder")
     pub.hold_until_flush()
     for k in range(5):
         pub.publish(String(data=f"held {k}"))
@@ -407,19 +415,35 @@ def test_a_held_publisher_sends_nothing_until_flushed_then_everything_in_order(r
     child.expect("^heard: after$")
 
 
+def test_a_held_publisher_with_a_bigger_batch_bound_sends_over_16_kb_at_the_flush(ros, spawn):
+    # the simulator holds ~17 KB of odometry per flush: above the default 16 KB bound, which
+    # would send part of it before the flush; with a 60 KB bound it all waits for the flush
+    from std_msgs.msg import String
+
+    from rosl.idl import registry
+
+    child, node, pub = _echoed_publisher(ros, spawn, "big_holder")
+    pub.hold_until_flush(60000)
+    store = registry.store()
+    count = 8  # 8 x 3 KB: 24 KB, over the default bound
+    pub.publish_all(
+        [bytes(store.serialize(String(data=f"big {k} " + "x" * 3000))) for k in range(count)]
+    )
+    spin_for(node, 0.5)
+    assert child.count("^heard: big") == 0  # nothing went before the flush
+    pub.flush()
+    for k in range(count):
+        child.expect(f"^heard: big {k} x{{3000}}$")
+    assert pub.record().stats["sent"] == count + 1
+
+
 @pytest.mark.parametrize("held", [True, False], ids=["held", "plain"])
 def test_publish_all_sends_serialized_messages_in_order_as_publish_would(ros, spawn, held):
     from std_msgs.msg import String
 
     from rosl.idl import registry
 
-    child = spawn(ECHO)  # prints what it hears on "ping"
-    child.expect("^ready$")
-    node = ros.Node("queuer")
-    pub = node.create_publisher(String, "ping", 10)
-    assert spin_until(node, lambda: pub.get_subscription_count() > 0, 20.0)
-    pub.publish(String(data="probe"))
-    child.expect("^heard: probe$")
+    child, node, pub = _echoed_publisher(ros, spawn, "queuer")
     if held:
         pub.hold_until_flush()
     store = registry.store()
