@@ -18,6 +18,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import datetime
+import errno
 import heapq
 import itertools
 import os
@@ -177,13 +178,18 @@ class Supervisor:
             env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
         hold = interrupts.HELD in env
         try:
+            if spec.cwd and not os.path.isdir(spec.cwd):  # as Popen says it, forked or not
+                raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), spec.cwd)
             popen = self._forked(spec, env, hold) or subprocess.Popen(
                 spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
                 preexec_fn=lambda: _prepare_child(hold),
             )  # fmt: skip
         except OSError as err:
-            self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
+            what = spec.cmd[0]
+            if spec.cwd and err.filename == spec.cwd:  # Popen names the folder it failed in
+                what = f"{spec.cmd[0]} in {spec.cwd} (cwd)"
+            self.log("ERROR", label, f"cannot start {what}: {err.strerror}")
             self.failed.append(label)
             return label
         self.started += 1

@@ -204,7 +204,11 @@ def _become_child(request: dict[str, Any], fds: list[int]) -> None:
     for fd in fds:
         os.close(fd)
     if request["cwd"]:
-        os.chdir(request["cwd"])
+        try:
+            os.chdir(request["cwd"])
+        except OSError as err:  # gone since the launcher looked: one line, as Popen's error
+            os.write(2, f"rosl: cannot start in {request['cwd']} (cwd): {err.strerror}\n".encode())
+            os._exit(1)
     zone = os.environ.get("TZ")
     os.environ.clear()
     os.environ.update(request["env"])

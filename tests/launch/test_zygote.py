@@ -80,16 +80,21 @@ MODES = [
 ]
 
 
+def _three_probes(launch_dir: Path, cwd: Path) -> Path:
+    """The three probes' launch file, the first started in ``cwd``."""
+    script = launch_dir / "probe.py"
+    script.write_text(PROBE, encoding="utf-8")
+    source = LAUNCH.format(folder=str(launch_dir), script=str(script), cwd=str(cwd))
+    return write_launch(launch_dir, "probe.launch.py", source)
+
+
 @pytest.mark.parametrize("env", MODES)
 def test_a_launched_rosl_entry_has_its_own_environment_folder_output_and_exit(
     rosl: Rosl, launch_dir: Path, tmp_path: Path, env: dict[str, str]
 ) -> None:
-    script = launch_dir / "probe.py"
-    script.write_text(PROBE, encoding="utf-8")
     cwd = tmp_path / "work"
     cwd.mkdir()
-    source = LAUNCH.format(folder=str(launch_dir), script=str(script), cwd=str(cwd))
-    path = write_launch(launch_dir, "probe.launch.py", source)
+    path = _three_probes(launch_dir, cwd)
 
     launch = rosl.start("launch", str(path), env=env)
 
@@ -383,3 +388,20 @@ def test_a_zygote_not_ready_in_time_forks_nothing(launch_dir: Path, domain_id: i
     finally:
         zygote.close()
     assert zygote.popen.returncode is not None
+
+
+@pytest.mark.parametrize("env", MODES)
+def test_a_missing_working_folder_is_one_line_naming_it(
+    rosl: Rosl, launch_dir: Path, tmp_path: Path, env: dict[str, str]
+) -> None:
+    missing = tmp_path / "no such folder"
+    path = _three_probes(launch_dir, missing)
+
+    launch = rosl.start("launch", str(path), env=env)
+    assert launch.wait_for(r"^\[waiting-3\] waiting$"), launch.both()  # the others start
+    assert launch.interrupt() == 1, launch.both()
+
+    err = launch.text("err") + launch.text("out")
+    assert f"[ERROR] [probe-1]: cannot start {sys.executable} in {missing} (cwd): " in err, err
+    assert "Traceback" not in err, err
+    assert "[probe-1] cwd" not in err, err
