@@ -113,7 +113,7 @@ class Publisher:
                 self.publish(payload)
             return
         self._writer.send_all(payloads)
-        self.last_published_ns = time.time_ns()
+        self.last_published_ns = time.monotonic_ns()  # as publish(): a local duration
 
     def replay(self, target: tuple[int, int]) -> None:
         """Send the kept history to one late subscriber (transient local)."""
