@@ -405,3 +405,51 @@ def test_a_missing_working_folder_is_one_line_naming_it(
     assert f"[ERROR] [probe-1]: cannot start {sys.executable} in {missing} (cwd): " in err, err
     assert "Traceback" not in err, err
     assert "[probe-1] cwd" not in err, err
+
+
+def _zombie_children(launcher: int) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            stat = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if stat[0] == "Z" and int(stat[1]) == launcher:
+            found.append(int(entry.name))
+    return found
+
+
+def test_processes_left_behind_by_a_launched_shell_are_reaped_not_kept_as_zombies(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    # the launcher inherits orphans (a subreaper, for the zygote's nodes); ended ones go
+    path = write_launch(
+        launch_dir,
+        "orphans.launch.py",
+        f"""
+        import sys
+        from launch import LaunchDescription
+        from launch.actions import ExecuteProcess
+
+        ENTRY = [sys.executable, "-P", "-m", "rosl.pkg.entry", {str(launch_dir)!r}]
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                ExecuteProcess(cmd=[*ENTRY, {str(launch_dir / "probe.py")!r}, "waiting"],
+                               output="screen", additional_env={{"PROBE_WAIT": "1"}}),
+                ExecuteProcess(cmd=["sh", "-c", "(sleep 0.2 &); (sleep 0.2 &); echo left"],
+                               output="screen"),
+            ])
+        """,
+    )
+    (launch_dir / "probe.py").write_text(PROBE, encoding="utf-8")
+
+    launch = rosl.start("launch", str(path), env={"ROSL_LAUNCH_ZYGOTE": "1"})
+    assert launch.wait_for(r"^\[python-1\] waiting$"), launch.both()
+    assert launch.wait_for(r"^\[sh-2\] left$"), launch.both()
+    assert launch.wait_for(r"\[sh-2\]: process has finished cleanly"), launch.both()
+    assert len(_zygote_children(launch.pid)) == 1  # the subreaper's reason is there
+
+    assert wait_until(lambda: not _zombie_children(launch.pid), 30.0), _zombie_children(launch.pid)
+    assert launch.interrupt() == 0, launch.both()
