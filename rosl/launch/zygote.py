@@ -36,6 +36,7 @@ from typing import IO, Any
 ENTRY = ("-P", "-m", "rosl.pkg.entry")
 SWITCH = "ROSL_LAUNCH_ZYGOTE"  # "0": every node in a fresh interpreter
 _PR_SET_PDEATHSIG = 1
+_PR_SET_NAME = 15
 _PR_SET_CHILD_SUBREAPER = 36
 READY_TIMEOUT = 60.0  # its warm-up, on a loaded machine (no node waits on it before it is ready)
 ANSWER_TIMEOUT = 10.0  # a warm zygote answers a fork at once
@@ -329,6 +330,12 @@ def _children() -> list[int]:
             with contextlib.suppress(OSError):
                 pids += [int(word) for word in (task / "children").read_text().split()]
     return pids
+
+
+def set_name(name: str) -> None:
+    """This process's name (``/proc/self/comm``, 15 bytes), as ``top`` and ``pgrep`` show it."""
+    if _PRCTL is not None:
+        _PRCTL(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]))
 
 
 def die_with_parent() -> None:

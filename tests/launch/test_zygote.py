@@ -453,3 +453,19 @@ def test_processes_left_behind_by_a_launched_shell_are_reaped_not_kept_as_zombie
 
     assert wait_until(lambda: not _zombie_children(launch.pid), 30.0), _zombie_children(launch.pid)
     assert launch.interrupt() == 0, launch.both()
+
+
+@pytest.mark.parametrize("env", MODES)
+def test_a_node_shows_its_own_command_line_and_name(
+    rosl: Rosl, launch_dir: Path, env: dict[str, str]
+) -> None:
+    launch = rosl.start("launch", str(_probe_launch(launch_dir, {"PROBE_WAIT": "1"})), env=env)
+    assert launch.wait_for(r"^\[probe-1\] waiting$"), launch.both()
+    [pid] = launch.pids()
+    shown = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode().strip()
+    name = Path(f"/proc/{pid}/comm").read_text().strip()
+    assert launch.interrupt() == 0, launch.both()
+
+    assert shown.startswith(f"{sys.executable} -P -m rosl.pkg.entry {launch_dir} "), shown
+    assert shown.endswith(" probe"), shown  # what ps and pgrep -f show, forked or not
+    assert name == Path(sys.executable).name[:15]
