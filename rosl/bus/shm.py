@@ -8,9 +8,11 @@ service traffic, replays, and any topic with a subscriber on another host — go
 wire as before. ``ROSL_SHM=0`` turns the path off (a process with it off announces no
 identity, so publishers send it the bytes).
 
-The host identity is the boot id, the network namespace (inode of ``/proc/self/ns/net``)
-and the user: a process in another network namespace counts as another host (it may be
-one, behind a veth), and another user cannot open our 0600 files.
+The host identity is the boot id, the network namespace (inode of ``/proc/self/ns/net``),
+the user and the ``/dev/shm`` mount (its device): a process in another network namespace
+counts as another host (it may be one, behind a veth), another user cannot open our 0600
+files, and a container sharing the host's network but with its own ``/dev/shm`` (Docker's
+``--network host`` without ``--ipc host``) sees none of our rings.
 
 Where rings live: ``/dev/shm/rosl-u<uid>-d<domain>-p<pid>-<sender>-e<endpoint>-r<n>``,
 mode 0600, created with ``O_EXCL|O_NOFOLLOW`` and memory reserved up front; readers open
@@ -90,14 +92,15 @@ def threshold(env: Mapping[str, str] | None = None) -> int:
 
 
 def host_identity() -> str:
-    """Boot id, network namespace and user: equal exactly where rings can be shared."""
+    """Boot id, network namespace, user and /dev/shm mount: equal where rings can be shared."""
     try:
         with open("/proc/sys/kernel/random/boot_id") as handle:
             boot = handle.read().strip()
         netns = os.stat("/proc/self/ns/net").st_ino
+        shm = os.stat(DIRECTORY).st_dev  # a container's own tmpfs is another device
     except OSError:
         return ""  # no /proc: no way to tell hosts apart, so never share
-    return f"{boot}/{netns}/{os.geteuid()}"
+    return f"{boot}/{netns}/{os.geteuid()}/{shm}"
 
 
 def start_time(pid: int) -> int | None:

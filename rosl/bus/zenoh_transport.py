@@ -25,6 +25,7 @@ import contextlib
 import json
 import threading
 import time
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -120,6 +121,7 @@ class ZenohTransport:
             f"{ROSL_PREFIX}/{domain}/**", self._on_rosl_datagram
         )
         self.foreign = ForeignGraph(self)
+        _close_before_threads_join(self)
         self._settle()
 
     def _settle(self, bound_s: float = SETTLE_S) -> None:
@@ -493,6 +495,24 @@ class ZenohTransport:
         self.local.update(None)
         with contextlib.suppress(Exception):  # closing at exit: nothing left to tell
             self.session.close()  # type: ignore[no-untyped-call]
+
+
+def _close_before_threads_join(transport: ZenohTransport) -> None:
+    """Close the session at exit before the interpreter waits for its threads.
+
+    zenoh-python runs Python callbacks on threads of its own that end only when what they
+    serve is undeclared: a program that never shuts rosl down (a script, a node killed by a
+    Ctrl-C) would wait for them forever, before any atexit handler could close the session.
+    """
+    ref = weakref.ref(transport)
+
+    def close() -> None:
+        alive = ref()
+        if alive is not None:
+            alive.close()
+
+    with contextlib.suppress(RuntimeError):  # the interpreter is shutting down already
+        threading._register_atexit(close)  # type: ignore[attr-defined]  # as concurrent.futures
 
 
 def _failure(err: Any) -> bytes:

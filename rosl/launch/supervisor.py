@@ -18,6 +18,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import datetime
+import errno
 import heapq
 import itertools
 import os
@@ -42,6 +43,7 @@ if TYPE_CHECKING:
 
     from rosl.launch.context import LaunchContext
 
+REAP_EVERY_S = 1.0  # how often a subreaper launcher reaps what it inherited
 _COLORS = ["\033[32m", "\033[34m", "\033[35m", "\033[36m", "\033[33m", "\033[92m", "\033[94m"]
 
 
@@ -113,6 +115,8 @@ class Supervisor:
         self._soon: collections.deque[Callable[[], None]] = collections.deque()  # other threads'
         self._zygote: zygote.Zygote | None = None
         self._zygote_failed = False
+        self._subreaper = False  # orphans come to this process: reaped every REAP_EVERY_S
+        self._next_reap = 0.0
         self._zygote_partial: dict[Any, bytes] = {}
 
     # --- logging -----------------------------------------------------------------------------
@@ -177,13 +181,18 @@ class Supervisor:
             env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
         hold = interrupts.HELD in env
         try:
+            if spec.cwd and not os.path.isdir(spec.cwd):  # as Popen says it, forked or not
+                raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), spec.cwd)
             popen = self._forked(spec, env, hold) or subprocess.Popen(
                 spec.cmd, env=env, cwd=spec.cwd, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
                 preexec_fn=lambda: _prepare_child(hold),
             )  # fmt: skip
         except OSError as err:
-            self.log("ERROR", label, f"cannot start {spec.cmd[0]}: {err.strerror}")
+            what = spec.cmd[0]
+            if spec.cwd and err.filename == spec.cwd:  # Popen names the folder it failed in
+                what = f"{spec.cmd[0]} in {spec.cwd} (cwd)"
+            self.log("ERROR", label, f"cannot start {what}: {err.strerror}")
             self.failed.append(label)
             return label
         self.started += 1
@@ -218,6 +227,7 @@ class Supervisor:
                 self.log("WARNING", "launch", f"nodes start in fresh interpreters: {err}")
                 return
             zygote.become_subreaper()  # should it die, its nodes become ours
+            self._subreaper = True  # and so do processes left behind by any process's child
             # its reports wake the loop (data None); its own output is shown prefixed
             self._selector.register(self._zygote.sock, selectors.EVENT_READ, None)
             for pipe, tag in (
@@ -542,6 +552,9 @@ class Supervisor:
                 self._finish(running)
             elif running.stopping:
                 self._escalate(running, now)
+        if self._subreaper and now >= self._next_reap:
+            self._next_reap = now + REAP_EVERY_S
+            zygote.reap_orphans()
 
     def _escalate(self, running: Running, now: float) -> None:
         sent_at, last = running.signals[-1]

@@ -30,11 +30,13 @@ import socket
 import subprocess
 import sys
 import time
+from pathlib import Path
 from typing import IO, Any
 
 ENTRY = ("-P", "-m", "rosl.pkg.entry")
 SWITCH = "ROSL_LAUNCH_ZYGOTE"  # "0": every node in a fresh interpreter
 _PR_SET_PDEATHSIG = 1
+_PR_SET_NAME = 15
 _PR_SET_CHILD_SUBREAPER = 36
 READY_TIMEOUT = 60.0  # its warm-up, on a loaded machine (no node waits on it before it is ready)
 ANSWER_TIMEOUT = 10.0  # a warm zygote answers a fork at once
@@ -293,6 +295,47 @@ def become_subreaper() -> None:
     """Inherit orphaned descendants (PR_SET_CHILD_SUBREAPER): a lost zygote's nodes."""
     if _PRCTL is not None:
         _PRCTL(_PR_SET_CHILD_SUBREAPER, 1)
+
+
+def reap_orphans() -> list[int]:
+    """Reap the ended processes this subreaper inherited from its children's subtrees.
+
+    A process a node or a shell leaves behind (``sh -c 'job &'``) comes to the launcher when
+    its parent ends; once it ends it would stay a zombie until the launch does. Reaped here
+    are only zombies in a session neither their own nor the launcher's: a node (forked or
+    started afresh) leads its own session and is waited for by its supervisor, and what the
+    launcher's own code started in its session is that code's to wait for.
+    """
+    own = os.getsid(0)
+    reaped = []
+    for pid in _children():
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_bytes().rsplit(b")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        state, session = fields[0], int(fields[3])
+        if state != b"Z" or session in (pid, own):
+            continue
+        with contextlib.suppress(ChildProcessError):
+            if os.waitpid(pid, os.WNOHANG)[0] == pid:
+                reaped.append(pid)
+    return reaped
+
+
+def _children() -> list[int]:
+    """This process's children (of every thread), from /proc (none where it cannot tell)."""
+    pids: list[int] = []
+    with contextlib.suppress(OSError):
+        for task in Path("/proc/self/task").iterdir():
+            with contextlib.suppress(OSError):
+                pids += [int(word) for word in (task / "children").read_text().split()]
+    return pids
+
+
+def set_name(name: str) -> None:
+    """This process's name (``/proc/self/comm``, 15 bytes), as ``top`` and ``pgrep`` show it."""
+    if _PRCTL is not None:
+        _PRCTL(_PR_SET_NAME, ctypes.c_char_p(name.encode()[:15]))
 
 
 def die_with_parent() -> None:

@@ -27,7 +27,7 @@ import sys
 import time
 from typing import Any
 
-from rosl.launch.zygote import die_with_parent
+from rosl.launch.zygote import ENTRY, die_with_parent, set_name
 
 _WARM_MODULES = (  # what a node imports (measured: the modules new after rosl.Node(...))
     "yaml",
@@ -204,7 +204,12 @@ def _become_child(request: dict[str, Any], fds: list[int]) -> None:
     for fd in fds:
         os.close(fd)
     if request["cwd"]:
-        os.chdir(request["cwd"])
+        try:
+            os.chdir(request["cwd"])
+        except OSError as err:  # gone since the launcher looked: one line, as Popen's error
+            os.write(2, f"rosl: cannot start in {request['cwd']} (cwd): {err.strerror}\n".encode())
+            os._exit(1)
+    _retitle(request["argv"])  # before the environment changes: it finds the title's room there
     zone = os.environ.get("TZ")
     os.environ.clear()
     os.environ.update(request["env"])
@@ -213,6 +218,16 @@ def _become_child(request: dict[str, Any], fds: list[int]) -> None:
     if request["hold"]:
         signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     signal.signal(signal.SIGINT, signal.default_int_handler)  # as a fresh interpreter has it
+
+
+def _retitle(argv: list[str]) -> None:
+    """Show the node's own command line (``ps``, ``pgrep -f``), as a fresh start would."""
+    try:
+        from setproctitle import setproctitle
+    except ImportError:  # not installed: the zygote's command line stays
+        return
+    setproctitle(" ".join([sys.executable, *ENTRY, *argv]))
+    set_name(os.path.basename(sys.executable))  # its name stays the interpreter's (top, pgrep)
 
 
 def main(argv: list[str]) -> int:

@@ -115,7 +115,7 @@ class Publisher:
                 self.flush()
             return
         self._writer.send_all(payloads, flush)
-        self.last_published_ns = time.time_ns()
+        self.last_published_ns = time.monotonic_ns()  # as publish(): a local duration
 
     def replay(self, target: tuple[int, int]) -> None:
         """Send the kept history to one late subscriber (transient local)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from typing import TYPE_CHECKING
 
@@ -14,26 +15,36 @@ if TYPE_CHECKING:
     from rosl.sim.report import SimReport
 
 
+def _positive(value: float) -> bool:
+    """Greater than 0 and finite (NaN is neither)."""
+    return math.isfinite(value) and value > 0
+
+
 def check_options(options: SimOptions) -> None:
     """Refuse options that cannot work, before anything starts.
 
     Raises:
         SimError: naming the option and what it needs.
     """
-    if options.real_time_factor <= 0:
+    if not _positive(options.real_time_factor):
         raise SimError(
-            f"--real-time-factor must be greater than 0, not {options.real_time_factor:g} "
-            "(use --fast to run as fast as the controllers allow)"
+            "--real-time-factor must be greater than 0 (and finite), "
+            f"not {options.real_time_factor:g} (use --fast to run as fast as the controllers allow)"
         )
-    if options.duration is not None and options.duration <= 0:
-        raise SimError(f"--duration must be greater than 0 seconds, not {options.duration:g}")
-    if not options.clock_rate > 0:  # also NaN
+    if options.duration is not None and not _positive(options.duration):
         raise SimError(
-            f"--clock-rate must be greater than 0 Hz, not {options.clock_rate:g} "
+            f"--duration must be greater than 0 seconds (and finite), not {options.duration:g}"
+        )
+    if not _positive(options.clock_rate):
+        raise SimError(
+            f"--clock-rate must be greater than 0 Hz (and finite), not {options.clock_rate:g} "
             "(a rate at or above the physics rate publishes /clock every step)"
         )
-    if options.lockstep_timeout <= 0:
-        raise SimError("--lockstep-timeout must be greater than 0 seconds")
+    if not _positive(options.lockstep_timeout):
+        raise SimError(
+            "--lockstep-timeout must be greater than 0 seconds (and finite), "
+            f"not {options.lockstep_timeout:g}"
+        )
     if options.render is not None and options.render.suffix.lower() not in (".svg", ".png"):
         raise SimError(f"--render {options.render}: the picture must be a .svg or .png file")
     record = options.record

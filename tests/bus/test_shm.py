@@ -8,6 +8,7 @@ with SIGKILL (a crashed publisher, whose ring the next process removes).
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import stat
 import subprocess
@@ -84,14 +85,17 @@ def ring_writer(
 
 
 def talk(
-    processes: Processes, count: int, listener_env: dict[str, str]
+    processes: Processes, count: int, listener_env: dict[str, str], prefix: tuple[str, ...] = ()
 ) -> tuple[subprocess.Popen[str], Lines, list[str]]:
-    """A listener, then a talker of ``count`` rounds; every round must arrive intact.
+    """A listener (its command after ``prefix``), then a talker of ``count`` rounds.
+
+    Every round must arrive intact.
 
     Returns:
         The talker, its output, and its counts of descriptors sent (image, text, small).
     """
-    listener = processes.python(snippets.LISTENER, "shm_listener", env=listener_env)
+    command = [*prefix, sys.executable, "-c", snippets.LISTENER, "shm_listener"]
+    listener = processes.start(command, env=listener_env)
     heard = Lines(listener.stdout)
     assert heard.wait_line("up", 30.0), Lines(listener.stderr).rest(2.0)
     talker = processes.python(snippets.TALKER, str(count), "1")
@@ -124,6 +128,20 @@ def test_a_subscriber_without_shared_memory_gets_the_bytes(
 ) -> None:
     _, _, shm = talk(processes, 5, {"ROSL_SHM": "0"})
     assert shm == ["0", "0", "0"]  # the listener announced no shared memory: all on the wire
+
+
+@pytest.mark.skipif(
+    os.geteuid() != 0 or shutil.which("unshare") is None, reason="needs root and unshare"
+)
+def test_a_subscriber_with_its_own_dev_shm_gets_the_bytes(
+    processes: Processes, domain_id: int
+) -> None:
+    # the same host, network and user, but a /dev/shm of its own (a container with the
+    # host's network and its own IPC): it cannot see the talker's rings
+    private = 'mount -t tmpfs -o size=16m tmpfs /dev/shm && exec "$@"'
+    prefix = ("unshare", "--mount", "--propagation", "private", "sh", "-c", private, "sh")
+    _, _, shm = talk(processes, 5, {}, prefix)
+    assert shm == ["0", "0", "0"]  # all on the wire
 
 
 def test_a_slow_subscriber_never_reads_an_overwritten_slot(

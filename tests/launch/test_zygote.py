@@ -80,16 +80,21 @@ MODES = [
 ]
 
 
+def _three_probes(launch_dir: Path, cwd: Path) -> Path:
+    """The three probes' launch file, the first started in ``cwd``."""
+    script = launch_dir / "probe.py"
+    script.write_text(PROBE, encoding="utf-8")
+    source = LAUNCH.format(folder=str(launch_dir), script=str(script), cwd=str(cwd))
+    return write_launch(launch_dir, "probe.launch.py", source)
+
+
 @pytest.mark.parametrize("env", MODES)
 def test_a_launched_rosl_entry_has_its_own_environment_folder_output_and_exit(
     rosl: Rosl, launch_dir: Path, tmp_path: Path, env: dict[str, str]
 ) -> None:
-    script = launch_dir / "probe.py"
-    script.write_text(PROBE, encoding="utf-8")
     cwd = tmp_path / "work"
     cwd.mkdir()
-    source = LAUNCH.format(folder=str(launch_dir), script=str(script), cwd=str(cwd))
-    path = write_launch(launch_dir, "probe.launch.py", source)
+    path = _three_probes(launch_dir, cwd)
 
     launch = rosl.start("launch", str(path), env=env)
 
@@ -383,3 +388,84 @@ def test_a_zygote_not_ready_in_time_forks_nothing(launch_dir: Path, domain_id: i
     finally:
         zygote.close()
     assert zygote.popen.returncode is not None
+
+
+@pytest.mark.parametrize("env", MODES)
+def test_a_missing_working_folder_is_one_line_naming_it(
+    rosl: Rosl, launch_dir: Path, tmp_path: Path, env: dict[str, str]
+) -> None:
+    missing = tmp_path / "no such folder"
+    path = _three_probes(launch_dir, missing)
+
+    launch = rosl.start("launch", str(path), env=env)
+    assert launch.wait_for(r"^\[waiting-3\] waiting$"), launch.both()  # the others start
+    assert launch.interrupt() == 1, launch.both()
+
+    err = launch.text("err") + launch.text("out")
+    assert f"[ERROR] [probe-1]: cannot start {sys.executable} in {missing} (cwd): " in err, err
+    assert "Traceback" not in err, err
+    assert "[probe-1] cwd" not in err, err
+
+
+def _zombie_children(launcher: int) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        try:
+            stat = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if stat[0] == "Z" and int(stat[1]) == launcher:
+            found.append(int(entry.name))
+    return found
+
+
+def test_processes_left_behind_by_a_launched_shell_are_reaped_not_kept_as_zombies(
+    rosl: Rosl, launch_dir: Path
+) -> None:
+    # the launcher inherits orphans (a subreaper, for the zygote's nodes); ended ones go
+    path = write_launch(
+        launch_dir,
+        "orphans.launch.py",
+        f"""
+        import sys
+        from launch import LaunchDescription
+        from launch.actions import ExecuteProcess
+
+        ENTRY = [sys.executable, "-P", "-m", "rosl.pkg.entry", {str(launch_dir)!r}]
+
+
+        def generate_launch_description():
+            return LaunchDescription([
+                ExecuteProcess(cmd=[*ENTRY, {str(launch_dir / "probe.py")!r}, "waiting"],
+                               output="screen", additional_env={{"PROBE_WAIT": "1"}}),
+                ExecuteProcess(cmd=["sh", "-c", "(sleep 0.2 &); (sleep 0.2 &); echo left"],
+                               output="screen"),
+            ])
+        """,
+    )
+    (launch_dir / "probe.py").write_text(PROBE, encoding="utf-8")
+
+    launch = rosl.start("launch", str(path), env={"ROSL_LAUNCH_ZYGOTE": "1"})
+    assert launch.wait_for(r"^\[python-1\] waiting$"), launch.both()
+    assert launch.wait_for(r"^\[sh-2\] left$"), launch.both()
+    assert launch.wait_for(r"\[sh-2\]: process has finished cleanly"), launch.both()
+    assert len(_zygote_children(launch.pid)) == 1  # the subreaper's reason is there
+
+    assert wait_until(lambda: not _zombie_children(launch.pid), 30.0), _zombie_children(launch.pid)
+    assert launch.interrupt() == 0, launch.both()
+
+
+@pytest.mark.parametrize("env", MODES)
+def test_a_node_shows_its_own_command_line_and_name(
+    rosl: Rosl, launch_dir: Path, env: dict[str, str]
+) -> None:
+    launch = rosl.start("launch", str(_probe_launch(launch_dir, {"PROBE_WAIT": "1"})), env=env)
+    assert launch.wait_for(r"^\[probe-1\] waiting$"), launch.both()
+    [pid] = launch.pids()
+    shown = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode().strip()
+    name = Path(f"/proc/{pid}/comm").read_text().strip()
+    assert launch.interrupt() == 0, launch.both()
+
+    assert shown.startswith(f"{sys.executable} -P -m rosl.pkg.entry {launch_dir} "), shown
+    assert shown.endswith(" probe"), shown  # what ps and pgrep -f show, forked or not
+    assert name == Path(sys.executable).name[:15]

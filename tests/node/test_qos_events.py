@@ -266,3 +266,24 @@ def test_manual_by_node_liveliness_in_one_process_as_the_liveliness_demo_runs(sp
     # the asserting timer was cancelled: both sides are told, in either order
     assert wait_until(lambda: child.count(r"^lost total=1$") == 1, BOUND), child.text
     assert wait_until(lambda: child.count(r"^changed alive=0 not_alive=1$") == 1, BOUND)
+
+
+def test_a_publisher_that_publishes_serialized_batches_is_told_its_deadline_missed(ros):
+    # publish_all (the simulator's paced topics) counts as publishing for the offered deadline
+    from rclpy.duration import Duration
+    from rclpy.event_handler import PublisherEventCallbacks
+    from rclpy.qos import QoSProfile
+    from std_msgs.msg import String
+
+    from rosl.idl import registry
+    from tests.node.helpers import spin_until
+
+    node = ros.Node("batcher")
+    missed = []
+    callbacks = PublisherEventCallbacks(deadline=lambda info: missed.append(info.total_count))
+    qos = QoSProfile(depth=10, deadline=Duration(seconds=0.2))
+    pub = node.create_publisher(String, "batched", qos, event_callbacks=callbacks)
+    pub.publish_all([bytes(registry.store().serialize(String(data="one")))])
+
+    assert spin_until(node, lambda: bool(missed), BOUND), "the deadline was never told missed"
+    node.destroy_node()
