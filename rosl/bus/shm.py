@@ -187,7 +187,7 @@ class SharedMemory:
         self._failed = False
         self._next_sweep = time.monotonic() + SWEEP_S
         self.swept = sweep(directory, self.uid)  # at start: what crashed processes left
-        self._finalizer = weakref.finalize(self, _close_rings, self._rings)
+        self._finalizer = weakref.finalize(self, _close_rings, self._rings, os.getpid())
 
     def path(self, sender: int, endpoint: int, pid: int, incarnation: int) -> str:
         """Where the ring of one endpoint (of one process start) is."""
@@ -271,7 +271,10 @@ class SharedMemory:
             self._finalizer()
 
 
-def _close_rings(rings: dict[tuple[int, int], RingWriter]) -> None:
+def _close_rings(rings: dict[tuple[int, int], RingWriter], owner: int) -> None:
+    # a child forked from the owner (os.fork, multiprocessing) unmaps but must not unlink
+    # the rings its parent still writes
+    unlink = os.getpid() == owner
     for ring in list(rings.values()):
-        ring.close()
+        ring.close(unlink)
     rings.clear()

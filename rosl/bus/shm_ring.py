@@ -242,8 +242,8 @@ class RingReader:
             self.unmapped += 1
             return None
         pid, incarnation, number, size = DESCRIPTOR.unpack(descriptor)
-        ring = self._ring((sender, endpoint, pid, incarnation))
-        if ring is None or size > ring.capacity:
+        ring = self._ring((sender, endpoint, pid, incarnation)) if number > 0 else None
+        if ring is None or size > ring.capacity:  # (writers number from 1: 0 was never written)
             self.unmapped += 1
             return None
         slot = number % ring.slots

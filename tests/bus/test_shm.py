@@ -260,3 +260,48 @@ def test_a_bad_shared_memory_setting_is_one_line_naming_it(
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert lines[0].startswith(words)
+
+
+def test_a_descriptor_of_message_zero_is_refused(bus: tuple[MulticastTransport, Receiver]) -> None:
+    # writers number their messages from 1; an unwritten slot's generation (0) equals what a
+    # message 0 would expect, so a forged descriptor naming 0 must not read the zeros there
+    from rosl.bus.shm_ring import DESCRIPTOR
+
+    transport, _ = bus
+    writer = Writer(transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
+    writer.use_shm(lambda: True)
+    writer.send(pattern(1, 100_000))
+    assert transport.shm is not None
+    reader = transport.shm.reader()
+    forged = DESCRIPTOR.pack(os.getpid(), 1, 0, 100_000)
+    assert reader.read(SENDER, ENDPOINT, forged) is None
+    assert reader.unmapped == 1
+    real = DESCRIPTOR.pack(os.getpid(), 1, 1, 100_000)
+    assert bytes(reader.read(SENDER, ENDPOINT, real) or b"") == pattern(1, 100_000)
+
+
+FORKED_CHILD = r"""
+import os, sys
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.wire import Writer
+
+transport = MulticastTransport(Addressing(int(sys.argv[1])))
+writer = Writer(transport, 0x5151, 7, "/shm_ring", "test/msg/Bytes")
+writer.use_shm(lambda: True)
+writer.send(bytes(100_000))
+path = transport.shm.path(0x5151, 7, os.getpid(), 1)
+child = os.fork()
+if child == 0:
+    sys.exit(0)  # the child's interpreter exits normally: finalizers and atexit run
+os.waitpid(child, 0)
+print("after fork", os.path.exists(path), flush=True)
+transport.close()
+print("after close", os.path.exists(path), flush=True)
+"""
+
+
+def test_a_forked_child_leaves_its_parents_rings(processes: Processes, domain_id: int) -> None:
+    child = processes.python(FORKED_CHILD, str(domain_id))
+    out = Lines(child.stdout)
+    assert out.wait_line("after fork", 30.0) == "after fork True", Lines(child.stderr).rest(2.0)
+    assert out.wait_line("after close", 30.0) == "after close False"
