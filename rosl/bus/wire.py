@@ -362,15 +362,20 @@ class Writer:
         goes through :meth:`send`. With ``flush``, then :meth:`flush`.
         """
         batch = self.batch
-        if batch is None or self.flags or not batch.fits(max(map(len, payloads), default=0)):
+        if not payloads:
+            if flush:
+                self.flush()
+            return
+        if batch is None or self.flags or not batch.fits(max(map(len, payloads))):
             for payload in payloads:  # (a big one keeps its place)
                 self.send(payload)
             if flush:
                 self.flush()
             return
-        first = next(self._seq)
         count = len(payloads)
-        self._seq = itertools.count(first + count)
+        # reserve count consecutive numbers in one C call (islice over the counter runs without
+        # a thread switch in CPython), so a send() on another thread cannot take one of them
+        first = next(itertools.islice(self._seq, count - 1, None)) - (count - 1)
         batch.add_all(first, time.time_ns(), payloads, flush)
         self.sent += count
         self.last_seq = (first + count - 1) & 0xFFFFFFFF

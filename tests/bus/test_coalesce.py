@@ -235,3 +235,36 @@ def test_after_the_flusher_closed_a_small_message_goes_out_at_once(domain_id: in
         assert [bytes(d.payload) for d in got] == [b"late"]
     finally:
         counted.close()
+
+
+
+def test_send_all_beside_sends_on_another_thread_never_repeats_a_number(domain_id: int) -> None:
+    # send_all reserves its numbers at once: a send() on another thread in between (the sim's
+    # flush beside a service's answer) must not take one of them
+    import sys
+    import threading
+
+    counted = Counted(domain_id, delay_s=0.005)
+    try:
+        writer = counted.bus.writer
+
+        def sender() -> None:
+            for _ in range(3000):
+                writer.send(b"x")
+
+        interval = sys.getswitchinterval()
+        sys.setswitchinterval(1e-6)  # threads switch between any two bytecodes, nearly
+        try:
+            thread = threading.Thread(target=sender)
+            thread.start()
+            while thread.is_alive():
+                writer.send_all([b"a", b"b", b"c"])
+            thread.join()
+        finally:
+            sys.setswitchinterval(interval)
+        counted.flusher.flush()
+        numbers = [r[0] for b in batched_records(counted.datagrams()) for r in b]
+        assert len(numbers) == writer.sent
+        assert sorted(numbers) == list(range(1, writer.sent + 1))  # each number once
+    finally:
+        counted.close()
