@@ -52,9 +52,14 @@ def test_a_poll_takes_no_more_than_the_limit_and_the_rest_waits_in_the_socket(do
     got: list[Delivery] = []
     with burst(domain_id) as (receiver, channel):
         receiver.backlog_ns = 60_000_000_000
-        taken = [take(receiver, channel, got, 10) for _ in range(BURST // 10)]
+        taken: list[int] = []
+        while len(got) < BURST and (not taken or taken[-1]):
+            taken.append(take(receiver, channel, got, 10))
 
-    assert taken == [10] * (BURST // 10)
+    # loopback may still be handing the burst to the socket at the first polls (a loaded
+    # machine defers it): a poll then takes fewer, never more
+    assert max(taken) == 10
+    assert len(taken) >= BURST // 10
     assert [d.seq for d in got] == list(range(1, BURST + 1))  # nothing lost, in order
 
 
