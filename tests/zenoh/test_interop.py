@@ -132,11 +132,13 @@ def test_the_peer_sees_rosl_liveliness_tokens(
                 if r.ok is not None
             ]
 
-        def published() -> bool:
-            return any("/MP/%/%robot1/talker/%robot1%chatter/" in t for t in tokens())
+        found: list[str] = []
 
-        assert wait_until(published, 30), tokens()
-        found = tokens()
+        def published() -> bool:  # (what the query that saw it got: a later one may time out)
+            found[:] = tokens()
+            return any("/MP/%/%robot1/talker/%robot1%chatter/" in t for t in found)
+
+        assert wait_until(published, 30), found
     assert any(re.fullmatch(rf"@ros2_lv/{domain_id}/[0-9a-f]+/(\d+)/\1/NN/%/%robot1/talker", t)
                for t in found), found  # fmt: skip
     assert any(t.endswith(
