@@ -237,7 +237,6 @@ def test_after_the_flusher_closed_a_small_message_goes_out_at_once(domain_id: in
         counted.close()
 
 
-
 def test_send_all_beside_sends_on_another_thread_never_repeats_a_number(domain_id: int) -> None:
     # send_all reserves its numbers at once: a send() on another thread in between (the sim's
     # flush beside a service's answer) must not take one of them
