@@ -116,7 +116,7 @@ class StreamStats:
     run: int = 2  # messages since the current segment began (a new stream counts as known)
 
 
-def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> int:
+def place_in_window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> int:
     """Place one message in its stream's window: ACCEPTED or JUMPED, else DUPLICATE or STALE.
 
     Inside :data:`DUP_WINDOW` of the newest number the bitmap decides. Leaving it (a gap of
@@ -163,7 +163,7 @@ def _window(stats: StreamStats, seq: int, stamp: int, now: int, loss: bool) -> i
             ):
                 stats.last_seq, stats.seen, stats.stamp, stats.pending, stats.lost = left
                 stats.left = None  # back on the segment a detour left
-                return _window(stats, seq, stamp, now, loss)
+                return place_in_window(stats, seq, stamp, now, loss)
             if stamp <= stats.stamp:
                 return STALE
             if stats.left is None or stats.run > 1:  # a segment of one message (a jump nothing
@@ -504,9 +504,9 @@ class Reader:
                     stats = self._open(self.others, key, topic, seq, stamp, now)
                     if stats is None:
                         continue
-                verdict = _window(stats, seq, stamp, now, False)
+                verdict = place_in_window(stats, seq, stamp, now, False)
             else:
-                verdict = _window(stats, seq, stamp, now, True)
+                verdict = place_in_window(stats, seq, stamp, now, True)
             if verdict:
                 if verdict > 0:
                     self._refuse(verdict)
@@ -577,7 +577,8 @@ class Reader:
             if stats is None:
                 return
         for seq, message_stamp, payload in records:
-            verdict = _window(stats, seq, stamp, now, loss)  # the datagram's stamp is signed
+            # the datagram's stamp is signed, not the records'
+            verdict = place_in_window(stats, seq, stamp, now, loss)
             if verdict:
                 if verdict > 0:
                     self._refuse(verdict)

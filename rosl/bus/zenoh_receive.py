@@ -17,8 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Kind
 from rosl.bus.transport import channel_of
-from rosl.bus.wire import Delivery, Reader, StreamStats
-from rosl.bus.wire import _window as count_in_window
+from rosl.bus.wire import Delivery, Reader, StreamStats, place_in_window
 from rosl.bus.zenoh_wire import GID_SIZE
 
 if TYPE_CHECKING:
@@ -222,7 +221,7 @@ class ZenohReceiver:
                 last_received=delivery.received,
             )  # fmt: skip
             self.reader.streams[key] = stats
-        return count_in_window(stats, delivery.seq, delivery.stamp, delivery.received, True) <= 0
+        return place_in_window(stats, delivery.seq, delivery.stamp, delivery.received, True) <= 0
 
     def wake(self) -> None:
         """Make a blocked (or the next) :meth:`poll` return."""
