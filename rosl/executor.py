@@ -96,6 +96,10 @@ class Executor:
         self._work = 0  # callbacks running (shutdown waits for them)
         self._work_lock = threading.Lock()
         self._inside = threading.local()  # depth: callbacks of this executor on this thread
+        # (the participant's `changes`, the nodes) when a wait ended at its timeout with nothing
+        # changed: until `changes` moves, only time does, and a look need only ask the timers
+        self._quiet: tuple[int, tuple[Node, ...]] | None = None
+        self._fast: Any = None  # the timer the last timers-only look handed out
 
     @property
     def context(self) -> Context:
@@ -344,7 +348,6 @@ class Executor:
         batch = self._batch
         context = self._context
         waited = False
-        quiet = None  # the participant's `changes` when a wait ended at its timeout
         while True:
             if self._is_shutdown:
                 raise ShutdownException
@@ -369,31 +372,39 @@ class Executor:
                 participant = None
             changes = None if participant is None else participant.changes
             chosen = self._nodes if only is None else only
-            if changes is not None and changes == quiet:
+            quiet = self._quiet
+            if quiet is not None and changes == quiet[0] and chosen is quiet[1]:
                 # the wait timed out with nothing changed: only time moved (all else that
                 # becomes ready or runnable says so through participant.notify()), so the
                 # first due timer is the one to run; the next call looks at the rest
-                for node in chosen:
-                    for timer in node.timers:
-                        if timer._ready() and self.can_execute(timer):
-                            timer._executor_event = True  # not offered again until taken
-                            return timer, node
+                due = self._due_timer(chosen)
+                if isinstance(due, tuple):
+                    return due
+                wait = due
             elif self._collect(chosen, batch):
                 continue
+            else:
+                wait = self._next_timer(chosen)
             remaining = None if deadline is None else deadline - time.monotonic()
             if remaining is not None and remaining <= 0 and waited:
                 raise TimeoutException
             if participant is not None and self.answers_lockstep and not self._work:
-                self._answer_lockstep(participant, chosen)  # (after every running callback)
-            wait = self._next_timer(chosen)
+                answerer = participant.answerer
+                if answerer is None or answerer.seen:
+                    self._answer_lockstep(participant, chosen)  # (after every running callback)
             if remaining is not None:
                 wait = max(0.0, remaining) if wait is None else min(wait, max(0.0, remaining))
             waited = True
             if participant is None:
                 time.sleep(0.05 if wait is None else min(wait, 0.05))
                 continue
+            assert changes is not None  # (read from the participant)
             # ends on any change since `changes` was read, or at `wait`: then this loop looks
-            quiet = None if participant.wait(_never, wait, changes) else changes
+            if wait is None:
+                changed = participant.wait(_never, wait, changes)
+            else:
+                changed = participant.wait_change(wait, changes)
+            self._quiet = None if changed else (changes, chosen)
 
     def _collect(
         self, nodes: tuple[Node, ...], into: deque[tuple[Any, Node | None]] | None
@@ -434,6 +445,29 @@ class Executor:
             found = True
         return found
 
+    def _due_timer(self, nodes: tuple[Node, ...]) -> tuple[Any, Node] | float | None:
+        """The first due timer that can run (marked in flight), else :meth:`_next_timer`.
+
+        One pass for both: a node that only has timers asks this at every wake-up.
+        """
+        soonest: int | None = None
+        for node in nodes:
+            for timer in node.timers:
+                if timer._canceled or timer._executor_event:
+                    continue
+                clock = timer.clock
+                until = timer._next_call_ns - clock.now_ns()
+                group = timer.callback_group
+                if group is not None and not timer._ungrouped and not group.can_execute(timer):
+                    continue
+                if until <= 0:
+                    timer._executor_event = True  # not offered again until taken
+                    self._fast = timer
+                    return timer, node
+                if clock._sim_ns is None and (soonest is None or until < soonest):
+                    soonest = until  # (sim-time timers are woken by /clock arriving)
+        return None if soonest is None else soonest / 1e9
+
     def _next_timer(self, nodes: tuple[Node, ...]) -> float | None:
         """Seconds until the next wall-time timer of these nodes that could run is due."""
         soonest: float | None = None
@@ -464,7 +498,9 @@ class Executor:
                 work = entity._take()
             finally:
                 entity._executor_event = False
-                if not isinstance(group, MutuallyExclusiveCallbackGroup):
+                if not isinstance(group, MutuallyExclusiveCallbackGroup) and (
+                    self._fast is not entity
+                ):
                     self.wake()  # it may be offered again (else: the group is free at _end)
             if work is None:
                 self._end(entity, group)
@@ -516,6 +552,15 @@ class Executor:
             group.ending_execution(entity)
         with self._work_lock:
             self._work -= 1
+            idle = not self._work
+        if self._fast is entity:
+            self._fast = None
+            participant = self._context.participant
+            if idle and participant is not None and participant.unwatched():
+                # a timer a timers-only look handed out, run with nothing else running and
+                # nobody waiting: its group is as free as at that look, so the next look may
+                # still ask only the timers (what its callback changed, it notified)
+                return
         self.wake()  # a mutually exclusive group is free again
 
     # --- lock-step ---------------------------------------------------------------------------

@@ -21,11 +21,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
 from rosl.bus import auth as keys
+from rosl.bus import kernel_filter
 from rosl.bus import shm as shared
 from rosl.bus.errors import BusError
 from rosl.bus.pacing import pacer_from_env
 from rosl.bus.settings import env_number
-from rosl.bus.transport import CHANNELS
+from rosl.bus.transport import CHANNELS, channel_of
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
@@ -283,7 +284,11 @@ class MulticastTransport:
 
 
 class MulticastReceiver:
-    """Channel sockets read with ``select``, woken through a pipe."""
+    """Channel sockets read with ``select``, woken through a pipe.
+
+    Each socket has a kernel filter (:mod:`rosl.bus.kernel_filter`) letting in only the topics
+    its reader wants: a busy topic sharing the channel of a quiet one wakes nobody else.
+    """
 
     def __init__(self, addressing: Addressing, auth: Auth | None = None) -> None:
         self.addressing = addressing
@@ -300,6 +305,10 @@ class MulticastReceiver:
         # per poll: a 1 kHz timer polls a thousand times a second)
         self._watched: list[socket.socket | int] = [self._wake_read]
         self._channels: dict[int, int] = {}  # id(socket) -> channel
+        # the reader's (want_all, wanted) the sockets' kernel filters were made from, and per
+        # channel the hashes its filter lets in (None: no filter)
+        self._filtered_from: tuple[bool, frozenset[int]] = (True, frozenset())
+        self._filters: dict[int, frozenset[int] | None] = {}
 
     def _rewatch(self) -> None:
         """Rebuild the every-channel watch list (under ``_lock``)."""
@@ -307,16 +316,43 @@ class MulticastReceiver:
         self._channels = {id(sock): number for number, sock in self._sockets.items()}
 
     def join(self, channel: int) -> None:
-        """Open the channel's socket (joining its group) unless it is open."""
+        """Open the channel's socket (joining its group) unless it is open; update its filter."""
         with self._lock:
-            if channel not in self._sockets and not self._closed:
+            if self._closed:
+                return
+            if channel not in self._sockets:
                 self._sockets[channel] = open_receiver(self.addressing, channel)
                 self._rewatch()
+            self._refilter()
+
+    def _refilter(self) -> None:
+        """Make each socket's kernel filter let in the topics the reader wants (under ``_lock``).
+
+        With ``want_all`` (recorders, monitors) nothing is filtered, nor is channel 0
+        (discovery only).
+        """
+        reader = self.reader
+        want_all, wanted = reader.want_all, frozenset(reader.wanted)
+        self._filtered_from = (want_all, wanted)
+        for channel, sock in self._sockets.items():
+            hashes = (
+                None
+                if want_all or channel == 0
+                else frozenset(h for h in wanted if channel_of(h) == channel)
+            )
+            if channel in self._filters and self._filters[channel] == hashes:
+                continue
+            if hashes is None:
+                kernel_filter.detach(sock)
+            elif not kernel_filter.attach(sock, hashes):
+                hashes = None
+            self._filters[channel] = hashes
 
     def leave(self, channel: int) -> None:
         """Close the channel's socket (leaving its group)."""
         with self._lock:
             sock = self._sockets.pop(channel, None)
+            self._filters.pop(channel, None)
             if sock is not None:
                 self._caught_up.pop(sock.fileno(), None)
                 self._rewatch()
@@ -337,6 +373,9 @@ class MulticastReceiver:
         with self._lock:
             if self._closed:
                 return 0
+            reader, (want_all, wanted) = self.reader, self._filtered_from
+            if reader.want_all is not want_all or reader.wanted != wanted:
+                self._refilter()  # the reader's topics changed since the filters were made
             if channel is None:
                 watched = self._watched  # replaced, never changed in place
             else:

@@ -81,6 +81,8 @@ class Discovery:
         self._reader.reassembler.budget = REASSEMBLY_BUDGET
         self._receiver.join(0)
         self._version = itertools.count(1)
+        self._announced = ""  # what the current version of our record says (its JSON)
+        self._current = 0  # the version of our record: it changes only with its content
         self._query_ids = itertools.count(1)
         self._queries: dict[int, _Query] = {}
         self._lock = threading.Lock()
@@ -206,13 +208,16 @@ class Discovery:
         self._has_announced = True
         shm = getattr(self._transport, "shm", None)
         record = ProcessRecord(
-            self.sender, os.getpid(), HOST, nodes, next(self._version), lockstep=self.lockstep,
+            self.sender, os.getpid(), HOST, nodes, 0, lockstep=self.lockstep,
             shm="" if shm is None else shm.host,
         )  # fmt: skip
+        process = to_json(record)
+        content = json.dumps(process, separators=(",", ":"))  # (stats are live: compare text)
+        if content != self._announced:  # receivers decode a record only when its version is new
+            self._announced, self._current = content, next(self._version)
+        process["version"] = self._current
         known = [f"{s:016x}" for s in self.cache.senders()]
-        self._send(
-            {"op": "hello", "process": to_json(record), "known": known, "reply_to": reply_to}
-        )
+        self._send({"op": "hello", "process": process, "known": known, "reply_to": reply_to})
 
     def _run(self) -> None:
         deliveries: list[Delivery] = []
@@ -271,11 +276,16 @@ class Discovery:
             callback(sender)
 
     def _on_hello(self, message: dict[str, Any], sender: int) -> None:
-        record = from_json(message["process"], time.monotonic())
-        if record.sender != sender:
-            self.malformed += 1
-            return
-        self.cache.update(record)
+        process = message["process"]
+        now = time.monotonic()
+        # a process repeats its record every period: the version it had renews the lease, with
+        # no decoding (with many processes, decoding every record each second adds up)
+        if not self.cache.renew(sender, int(process["version"]), now):
+            record = from_json(process, now)
+            if record.sender != sender:
+                self.malformed += 1
+                return
+            self.cache.update(record)
         known = {int(s, 16) for s in message.get("known", [])}
         mine = f"{self.sender:016x}:"
         with self._lock:

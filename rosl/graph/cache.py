@@ -5,6 +5,7 @@ from __future__ import annotations
 import threading
 import time
 from collections import defaultdict
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from rosl.graph.records import (
@@ -52,6 +53,15 @@ class GraphCache:
         if changed:
             self._tell()
         return changed
+
+    def renew(self, sender: int, version: int, seen: float) -> bool:
+        """Renew a process's lease when ``version`` is the record held; whether it was."""
+        with self._changed:
+            old = self._processes.get(sender)
+            if old is None or old.version != version:
+                return False
+            self._processes[sender] = replace(old, seen=seen)
+            return True
 
     def remove(self, sender: int) -> None:
         """Forget a process (it said goodbye)."""

@@ -222,6 +222,39 @@ class Participant:
             with self._cond:
                 self._cond.notify_all()
 
+    def unwatched(self) -> bool:
+        """Whether no thread is waiting in :meth:`wait` or polling (one that would want a wake)."""
+        return self._poller is None and not self._waiting
+
+    def wait_change(self, timeout: float, since: int) -> bool:
+        """Whether anything changed since ``since`` within ``timeout`` seconds.
+
+        :meth:`wait` given ``since``, trimmed for an executor whose nodes only wait for their
+        next timer (a 1 kHz timer asks a thousand times a second): one poll, when no other
+        thread is polling.
+        """
+        if self.changes != since:
+            return True
+        if not self._poll_once(timeout, since):
+            return self.wait(_never, timeout, since)
+        return self.changes != since
+
+    def _poll_once(self, timeout: float | None, snapshot: int) -> bool:
+        """Poll once unless another thread is polling (False) or ``changes`` moved."""
+        if self.closed or not self._poll_lock.acquire(blocking=False):
+            return False
+        try:
+            self._poller = threading.get_ident()
+            if self.changes == snapshot:  # else something changed: look again first
+                self._poll_locked(timeout, None)
+        finally:
+            self._poller = None
+            self._poll_lock.release()
+            if self._waiting:  # another thread may take over polling, or was served
+                with self._cond:
+                    self._cond.notify_all()
+        return True
+
     def wait(
         self, ready: Callable[[], bool], timeout: float | None, since: int | None = None
     ) -> bool:
@@ -250,17 +283,9 @@ class Participant:
                     return False if since is not None else ready()
                 remaining = max(0.0, remaining)
             first = False
-            if not self.closed and self._poll_lock.acquire(blocking=False):
-                try:
-                    self._poller = threading.get_ident()
-                    if self.changes == snapshot:  # else something changed: look again first
-                        self._poll_locked(remaining, None)
-                finally:
-                    self._poller = None
-                    self._poll_lock.release()
-                    if self._waiting:  # another thread may take over polling, or was served
-                        with self._cond:
-                            self._cond.notify_all()
+            if self._poll_once(remaining, snapshot):
+                if since is not None and remaining is not None and self.changes == since:
+                    return False  # the poll's time is up (or it woke for nothing: look again)
                 continue
             with self._cond:
                 self._waiting += 1
@@ -359,3 +384,7 @@ class Participant:
 
 def _send_order(delivery: Delivery) -> int:
     return delivery.stamp
+
+
+def _never() -> bool:
+    return False

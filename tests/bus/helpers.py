@@ -11,6 +11,8 @@ import threading
 import time
 from typing import TYPE_CHECKING
 
+from rosl.bus.header import topic_hash
+from rosl.bus.transport import channel_of
 from tests.conftest import LOCK_DIR
 
 if TYPE_CHECKING:
@@ -19,6 +21,16 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
     from rosl.bus.wire import Delivery, Reader
+
+
+def same_channel_name(name: str, prefix: str | None = None) -> str:
+    """Another topic name (``prefix`` + a number) whose hash lands on ``name``'s channel."""
+    channel = channel_of(topic_hash(name))
+    for i in range(10_000):
+        other = f"{name}_other{i}" if prefix is None else f"{prefix}{i}"
+        if channel_of(topic_hash(other)) == channel:
+            return other
+    raise AssertionError("no topic name on the same channel")
 
 
 @contextlib.contextmanager

@@ -37,7 +37,7 @@ from rosl.bus.multicast import (
 from rosl.bus.transport import channel_of
 from rosl.bus.wire import Reader, Writer
 from rosl.errors import RoslError
-from tests.bus.helpers import Collector, Lines, another_domain, wait_exit
+from tests.bus.helpers import Collector, Lines, another_domain, same_channel_name, wait_exit
 
 if TYPE_CHECKING:
     from collections.abc import Iterator
@@ -50,16 +50,6 @@ TYPE = "test_msgs/msg/Blob"
 SENDER = 0x1234_5678_9ABC_DEF1
 ENDPOINT = 7
 CHUNK = 65000 - HEADER_SIZE - MAC_SIZE  # payload bytes of one (signed) datagram
-
-
-def same_channel_name(name: str) -> str:
-    """Another topic name whose hash lands on the same channel as ``name``."""
-    channel = channel_of(topic_hash(name))
-    for i in range(10_000):
-        other = f"{name}_other{i}"
-        if channel_of(topic_hash(other)) == channel:
-            return other
-    raise AssertionError("no topic name on the same channel")
 
 
 class Bus:
