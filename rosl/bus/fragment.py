@@ -35,8 +35,12 @@ MAX_AGE_NS = 1_000_000_000
 
 
 def budget_from_env() -> int:
-    """The reassembly budget in bytes (``ROSL_REASSEMBLY_MB``; a bad value: the default)."""
-    return int(max(1.0, env_number("ROSL_REASSEMBLY_MB", BUDGET_MB)) * 1024 * 1024)
+    """The reassembly budget in bytes (``ROSL_REASSEMBLY_MB``, else the default).
+
+    Raises:
+        BusError: ``ROSL_REASSEMBLY_MB`` is not a number of MiB from 1.
+    """
+    return int(env_number("ROSL_REASSEMBLY_MB", BUDGET_MB, "MiB", least=1.0) * 1024 * 1024)
 
 
 def split(

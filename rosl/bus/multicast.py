@@ -186,8 +186,12 @@ def open_receiver(addressing: Addressing, channel: int) -> socket.socket:
 
 
 def backlog_from_env() -> int:
-    """How long (ns) messages may wait in a socket for a queue: ``ROSL_BACKLOG_MS`` or default."""
-    return int(max(0.0, env_number("ROSL_BACKLOG_MS", BACKLOG_MS)) * 1_000_000)
+    """How long (ns) messages may wait in a socket for a queue: ``ROSL_BACKLOG_MS`` or default.
+
+    Raises:
+        BusError: ``ROSL_BACKLOG_MS`` is not a number of milliseconds from 0.
+    """
+    return int(env_number("ROSL_BACKLOG_MS", BACKLOG_MS, "milliseconds") * 1_000_000)
 
 
 def _check_rcvbuf(sock: socket.socket) -> None:

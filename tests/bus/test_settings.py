@@ -1,4 +1,4 @@
-"""The bus's numeric settings: a number from the environment, the default for anything else."""
+"""The bus's numeric settings: a number from the environment, one line naming a bad one."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from rosl.bus.errors import BusError
 from rosl.bus.fragment import BUDGET_MB, budget_from_env
 from rosl.bus.multicast import BACKLOG_MS, backlog_from_env
 from rosl.bus.settings import env_number
@@ -16,37 +17,56 @@ from rosl.bus.settings import env_number
 @pytest.mark.parametrize(("text", "expected"), [("250", 250.0), (" 0.5 ", 0.5), ("1e3", 1000.0)])
 def test_a_number_in_the_environment_is_taken(monkeypatch, text, expected):
     monkeypatch.setenv("ROSL_TEST_SETTING", text)
-    assert env_number("ROSL_TEST_SETTING", 7.0) == expected
+    assert env_number("ROSL_TEST_SETTING", 7.0, "things") == expected
 
 
-@pytest.mark.parametrize("text", ["", "   ", "fast", "12ms", "inf", "-inf", "nan"])
-def test_an_unset_or_unreadable_setting_is_the_default(monkeypatch, text):
+@pytest.mark.parametrize("text", ["", "   "])
+def test_an_unset_setting_is_the_default(monkeypatch, text):
     monkeypatch.setenv("ROSL_TEST_SETTING", text)
-    assert env_number("ROSL_TEST_SETTING", 7.0) == 7.0
+    assert env_number("ROSL_TEST_SETTING", 7.0, "things") == 7.0
 
 
-def test_the_backlog_bound_is_in_milliseconds_and_never_negative(monkeypatch):
+@pytest.mark.parametrize("text", ["fast", "12ms", "inf", "-inf", "nan", "-1"])
+def test_a_bad_setting_is_an_error_naming_it(monkeypatch, text):
+    monkeypatch.setenv("ROSL_TEST_SETTING", text)
+    with pytest.raises(BusError) as caught:
+        env_number("ROSL_TEST_SETTING", 7.0, "things")
+    assert str(caught.value) == (
+        f"ROSL_TEST_SETTING={text!r} is not a number of things from 0 (unset: 7)"
+    )
+
+
+def test_the_backlog_bound_is_in_milliseconds(monkeypatch):
     monkeypatch.setenv("ROSL_BACKLOG_MS", "250")
     assert backlog_from_env() == 250_000_000
-    monkeypatch.setenv("ROSL_BACKLOG_MS", "-5")
+    monkeypatch.setenv("ROSL_BACKLOG_MS", "0")
     assert backlog_from_env() == 0
-    monkeypatch.setenv("ROSL_BACKLOG_MS", "soon")
+    monkeypatch.delenv("ROSL_BACKLOG_MS")
     assert backlog_from_env() == BACKLOG_MS * 1_000_000
 
 
-def test_the_reassembly_budget_still_reads_megabytes(monkeypatch):
+def test_the_reassembly_budget_reads_megabytes_from_one(monkeypatch):
     monkeypatch.setenv("ROSL_REASSEMBLY_MB", "2")
     assert budget_from_env() == 2 * 1024 * 1024
-    monkeypatch.setenv("ROSL_REASSEMBLY_MB", "lots")
+    monkeypatch.delenv("ROSL_REASSEMBLY_MB")
     assert budget_from_env() == BUDGET_MB * 1024 * 1024
+    monkeypatch.setenv("ROSL_REASSEMBLY_MB", "0.5")
+    with pytest.raises(BusError, match="from 1 "):
+        budget_from_env()
 
 
-@pytest.mark.parametrize("name", ["ROSL_BACKLOG_MS", "ROSL_REASSEMBLY_MB"])
-def test_an_infinite_setting_is_the_default_in_a_command(domain_id, name):
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [("ROSL_BACKLOG_MS", "inf"), ("ROSL_BACKLOG_MS", "soon"), ("ROSL_REASSEMBLY_MB", "lots")],
+)
+def test_a_bad_setting_in_a_command_is_one_line_and_exit_1(domain_id, name, value):
     done = subprocess.run(
         [sys.executable, "-m", "rosl", "topic", "list"],
         capture_output=True, text=True, timeout=60, check=False,
-        env={**os.environ, name: "inf"},
+        env={**os.environ, "ROS_DOMAIN_ID": str(domain_id), name: value},
     )  # fmt: skip
-    assert done.returncode == 0, done.stderr
+    assert done.returncode == 1, done.stderr
     assert "Traceback" not in done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith(f"{name}={value!r} is not a number of "), lines
