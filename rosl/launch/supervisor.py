@@ -118,6 +118,7 @@ class Supervisor:
         self._subreaper = False  # orphans come to this process: reaped every REAP_EVERY_S
         self._next_reap = 0.0
         self._zygote_partial: dict[Any, bytes] = {}
+        self.screen_closed = False  # the stream's reader went away (a closed pipe)
 
     # --- logging -----------------------------------------------------------------------------
 
@@ -137,9 +138,16 @@ class Supervisor:
         self._write_log(line)
 
     def _write_screen(self, line: str) -> None:
+        if self.screen_closed:
+            return
         try:
             self.stream.write(line + "\n")
             self.stream.flush()
+        except BrokenPipeError:
+            # whoever read the output is gone (`rosl launch ... | head`): as a Ctrl-C, the
+            # processes are stopped; the rest of the output still goes to launch.log
+            self.screen_closed = True
+            self.request_shutdown("standard output closed")
         except (OSError, ValueError):
             pass
 

@@ -10,6 +10,7 @@ the launcher's own interpreter starts, before any rosl code runs, is Python's to
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -170,3 +171,34 @@ def test_a_sigint_while_the_run_node_starts_ends_it_quietly(
     assert child.returncode in (0, 130, -signal.SIGINT), (child.returncode, err)
     assert "Traceback" not in err, err
     assert "Fatal Python error" not in err, err
+
+
+def test_a_closed_output_pipe_ends_the_launch_as_a_ctrl_c_does(rosl: Rosl) -> None:
+    """``rosl launch ... | head -3``: once head is gone, the launch stops its nodes and exits."""
+    child = subprocess.Popen(
+        [sys.executable, "-m", "rosl", "launch", "tutorial_pkg", "my_launch.py"],
+        env={**os.environ, "PYTHONUNBUFFERED": "1"}, stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+    )  # fmt: skip
+    rosl.processes.started.append(child)  # ended by pid by the processes fixture
+    assert child.stdout is not None
+    assert child.stderr is not None
+    pids: list[int] = []
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline:  # as head does: read until every node is up
+        line = child.stdout.readline().decode()
+        pids += [int(p) for p in re.findall(r"process started with pid \[(\d+)\]", line)]
+        if not line or re.search(r"\[timer_node\]: Timer period: 1\.5 s$", line):
+            break
+    assert len(pids) == 3, pids
+    child.stdout.close()  # head exits: the launcher's next line meets a closed pipe
+
+    try:
+        code = child.wait(timeout=EXIT_BOUND_S)  # timer_node prints every 1.5 s
+    except subprocess.TimeoutExpired:
+        pytest.fail(f"still running {EXIT_BOUND_S} s after its output pipe closed")
+    err = child.stderr.read().decode()
+    assert code == 0, f"exit {code} after its output pipe closed\n{err}"
+    assert "Traceback" not in err, err
+    assert "Exception ignored" not in err, err
+    assert_all_gone(pids)
