@@ -528,6 +528,10 @@ class Supervisor:
         finally:
             self.kill_all()
             self._close_zygote()
+            if self._subreaper:  # the launch is over: this process (maybe a test's) is not
+                zygote.reap_orphans()  # a subreaper any longer
+                zygote.become_subreaper(False)
+                self._subreaper = False
             if installed_here:
                 self.restore_signal_handlers()
             if self._log_file is not None:

@@ -291,10 +291,13 @@ def _libc_prctl() -> Any:
 _PRCTL = _libc_prctl()  # looked up here: a forked child (maybe of a threaded parent) only calls
 
 
-def become_subreaper() -> None:
-    """Inherit orphaned descendants (PR_SET_CHILD_SUBREAPER): a lost zygote's nodes."""
+def become_subreaper(on: bool = True) -> None:
+    """Inherit orphaned descendants (PR_SET_CHILD_SUBREAPER): a lost zygote's nodes.
+
+    ``on`` False: stop (orphans go to init again), once a launch in this process is over.
+    """
     if _PRCTL is not None:
-        _PRCTL(_PR_SET_CHILD_SUBREAPER, 1)
+        _PRCTL(_PR_SET_CHILD_SUBREAPER, 1 if on else 0)
 
 
 def reap_orphans() -> list[int]:

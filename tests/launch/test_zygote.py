@@ -25,6 +25,7 @@ from tests.conftest import wait_until
 from tests.launch.support import assert_all_gone, running, write_launch
 
 if TYPE_CHECKING:
+    from tests.conftest import Processes
     from tests.launch.support import Output, Rosl
 
 PROBE = """
@@ -469,3 +470,40 @@ def test_a_node_shows_its_own_command_line_and_name(
     assert shown.startswith(f"{sys.executable} -P -m rosl.pkg.entry {launch_dir} "), shown
     assert shown.endswith(" probe"), shown  # what ps and pgrep -f show, forked or not
     assert name == Path(sys.executable).name[:15]
+
+
+IN_PROCESS = """
+import ctypes
+import os
+import sys
+
+import rosl  # noqa: F401 - the launch package's alias
+from launch import LaunchDescription, LaunchService
+from launch.actions import ExecuteProcess
+
+prctl = ctypes.CDLL(None, use_errno=True).prctl
+flag = ctypes.c_int(-1)
+service = LaunchService()
+service.include_launch_description(LaunchDescription([
+    ExecuteProcess(cmd=sys.argv[1:], name="probe", output="screen"),
+]))
+print("launcher", os.getpid(), flush=True)
+print("launch exit", service.run(), flush=True)
+prctl(37, ctypes.byref(flag))  # PR_GET_CHILD_SUBREAPER
+print("subreaper after", flag.value, flush=True)
+"""
+
+
+def test_an_in_process_launch_leaves_its_process_no_subreaper(
+    processes: Processes, launch_dir: Path, domain_id: int
+) -> None:
+    # a launch forking nodes makes its process a subreaper (a lost zygote's nodes come to
+    # it); a program that ran a launch in-process goes on without inheriting orphans
+    child = processes.python(IN_PROCESS, *_entry(launch_dir), env={"ROSL_LAUNCH_ZYGOTE": "1"})
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 0, err
+    assert "launch exit 0" in out, out + err
+    launcher = out.split("launcher ", 1)[1].split()[0]
+    parent = out.split("[probe-1] parent ", 1)[1].split()[0]
+    assert parent != launcher, out  # forked from the zygote: the flag was set
+    assert "subreaper after 0" in out, out + err
