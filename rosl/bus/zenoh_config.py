@@ -2,8 +2,8 @@
 
 * a session (every rosl process on the Zenoh transport) is a peer that connects to the router
   at ``tcp/localhost:7447`` and listens on a free port of localhost, with multicast scouting
-  off, as rmw_zenoh's default session configuration; ``ZENOH_SESSION_CONFIG_URI`` names a
-  Zenoh configuration file to start from instead;
+  off and Zenoh's shared memory off, as rmw_zenoh's default session configuration;
+  ``ZENOH_SESSION_CONFIG_URI`` names a Zenoh configuration file to start from instead;
 * ``rosl zenoh router`` opens a session in router mode listening on ``tcp/127.0.0.1:7447``;
   ``ZENOH_ROUTER_CONFIG_URI`` names a file to start from instead;
 * peers dial each other one way only (the greater Zenoh id dials) unless the file says
@@ -94,6 +94,9 @@ def session_config() -> zenoh.Config:
         "connect/endpoints": f'["{ROUTER_ENDPOINT}"]',
         "listen/endpoints": '["tcp/localhost:0"]',
         "scouting/multicast/enabled": "false",
+        # rmw_zenoh's default too; zenoh's own would map a shared-memory pool in /dev/shm that
+        # a killed process leaves behind (rosl's own rings carry large messages on one host)
+        "transport/shared_memory/enabled": "false",
     }
     config = _base("ZENOH_SESSION_CONFIG_URI", defaults)
     if config.get_json(f"{GOSSIP}/autoconnect_strategy") in ("null", ""):
@@ -110,6 +113,7 @@ def router_config(listen: str | None = None) -> zenoh.Config:
         "mode": '"router"',
         "listen/endpoints": json.dumps([ROUTER_LISTEN]),
         "scouting/multicast/enabled": "false",
+        "transport/shared_memory/enabled": "false",
     }
     config = apply_overrides(_base("ZENOH_ROUTER_CONFIG_URI", defaults))
     if listen:  # the command line wins over the file and the overrides

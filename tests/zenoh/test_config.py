@@ -106,3 +106,17 @@ def test_a_second_router_on_a_taken_port_is_one_line(router: Router, processes: 
     assert child.returncode == 1
     assert len(err.strip().splitlines()) == 1
     assert "cannot open a Zenoh session" in err
+
+
+def test_zenohs_shared_memory_is_off_as_in_rmw_zenoh(monkeypatch) -> None:
+    # rmw_zenoh's DEFAULT_RMW_ZENOH_SESSION_CONFIG.json5 has transport/shared_memory/enabled
+    # false; zenoh's own default (true) maps a pool in /dev/shm that a killed process leaves
+    from rosl.bus.zenoh_config import router_config, session_config
+
+    monkeypatch.delenv("ZENOH_SESSION_CONFIG_URI", raising=False)
+    monkeypatch.delenv("ZENOH_ROUTER_CONFIG_URI", raising=False)
+    monkeypatch.delenv("ZENOH_CONFIG_OVERRIDE", raising=False)
+    assert session_config().get_json("transport/shared_memory/enabled") == "false"
+    assert router_config().get_json("transport/shared_memory/enabled") == "false"
+    monkeypatch.setenv("ZENOH_CONFIG_OVERRIDE", "transport/shared_memory/enabled=true")
+    assert session_config().get_json("transport/shared_memory/enabled") == "true"
