@@ -31,6 +31,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import platform
 import re
 import sys
 import threading
@@ -56,10 +57,15 @@ STALE_PARTIAL_S = 60.0  # a file with no readable header this old is a half-made
 _NAME = re.compile(r"^rosl-u(\d+)-d(\d+)-p(\d+)-[0-9a-f]{16}-e\d+-r\d+$")
 _OFF = ("0", "off", "false", "no")
 _ON = ("", "1", "on", "true", "yes")
+_ORDERED_CPUS = ("x86_64", "amd64", "i386", "i686")  # total store order
 
 
-def enabled(env: Mapping[str, str] | None = None) -> bool:
+def enabled(env: Mapping[str, str] | None = None, machine: str | None = None) -> bool:
     """Whether this process may use shared memory (``ROSL_SHM``, and a usable /dev/shm).
+
+    Unset, it is on where the CPU keeps stores in program order (x86-64, which the ring's
+    sequence check relies on, see :mod:`rosl.bus.shm_ring`) and off elsewhere (ARM): there
+    ``ROSL_SHM=1`` turns it on knowingly.
 
     Raises:
         BusError: ``ROSL_SHM`` is neither on (1, on, true, yes) nor off (0, off, false, no).
@@ -70,6 +76,9 @@ def enabled(env: Mapping[str, str] | None = None) -> bool:
         return False
     if value not in _ON:
         raise BusError(f"ROSL_SHM={value!r} is neither on (1, on, true, yes) nor off (0, off)")
+    cpu = (platform.machine() if machine is None else machine).lower()
+    if not value and cpu not in _ORDERED_CPUS:
+        return False
     return os.path.isdir(DIRECTORY) and os.access(DIRECTORY, os.W_OK | os.X_OK)
 
 

@@ -305,3 +305,21 @@ def test_a_forked_child_leaves_its_parents_rings(processes: Processes, domain_id
     out = Lines(child.stdout)
     assert out.wait_line("after fork", 30.0) == "after fork True", Lines(child.stderr).rest(2.0)
     assert out.wait_line("after close", 30.0) == "after close False"
+
+
+@pytest.mark.parametrize(
+    ("value", "machine", "expected"),
+    [
+        ("", "x86_64", True),
+        ("", "aarch64", False),  # the ring's sequence check needs ordered stores
+        ("", "armv7l", False),
+        ("1", "aarch64", True),  # asked for knowingly
+        ("off", "x86_64", False),
+    ],
+)
+def test_shared_memory_is_on_by_default_only_where_stores_stay_in_order(
+    value: str, machine: str, expected: bool
+) -> None:
+    from rosl.bus.shm import enabled
+
+    assert enabled({"ROSL_SHM": value}, machine) is expected
