@@ -100,6 +100,7 @@ class Executor:
         # changed: until `changes` moves, only time does, and a look need only ask the timers
         self._quiet: tuple[int, tuple[Node, ...]] | None = None
         self._fast: Any = None  # the timer the last timers-only look handed out
+        self._fast_thread = 0  # the thread that looked
 
     @property
     def context(self) -> Context:
@@ -463,6 +464,7 @@ class Executor:
                 if until <= 0:
                     timer._executor_event = True  # not offered again until taken
                     self._fast = timer
+                    self._fast_thread = threading.get_ident()
                     return timer, node
                 if clock._sim_ns is None and (soonest is None or until < soonest):
                     soonest = until  # (sim-time timers are woken by /clock arriving)
@@ -499,7 +501,7 @@ class Executor:
             finally:
                 entity._executor_event = False
                 if not isinstance(group, MutuallyExclusiveCallbackGroup) and (
-                    self._fast is not entity
+                    self._fast is not entity or threading.get_ident() != self._fast_thread
                 ):
                     self.wake()  # it may be offered again (else: the group is free at _end)
             if work is None:
@@ -556,10 +558,16 @@ class Executor:
         if self._fast is entity:
             self._fast = None
             participant = self._context.participant
-            if idle and participant is not None and participant.unwatched():
-                # a timer a timers-only look handed out, run with nothing else running and
-                # nobody waiting: its group is as free as at that look, so the next look may
-                # still ask only the timers (what its callback changed, it notified)
+            if (
+                idle
+                and participant is not None
+                and participant.unwatched()
+                and threading.get_ident() == self._fast_thread
+            ):
+                # a timer a timers-only look handed out, run by the thread that looked, with
+                # nothing else running and nobody waiting: its group is as free as at that
+                # look, so the next look may still ask only the timers (what its callback
+                # changed, it notified)
                 return
         self.wake()  # a mutually exclusive group is free again
 

@@ -921,6 +921,56 @@ def test_a_guard_triggered_while_spin_once_waits_for_a_distant_timer_runs_first(
     assert ticks == []
 
 
+def test_what_a_timer_callback_makes_ready_runs_before_the_next_tick(ros):
+    # a timer handed out by the timers-only look ends without telling anyone (nobody else
+    # waits): what its own callback made ready must still be seen by the next look (the
+    # message comes back through the bus, so only its arrival is checked)
+    node, executor = settled(ros, "ticker_that_triggers")
+    order: list[str] = []
+    guard = node.create_guard_condition(lambda: order.append("guard"))
+    from rosl.idl.registry import get_message_class
+
+    String = get_message_class("std_msgs/msg/String")
+    node.create_subscription(String, "/from_a_tick", lambda m: order.append(m.data), 10)
+    talker = node.create_publisher(String, "/from_a_tick", 10)
+
+    def tick() -> None:
+        order.append("tick")
+        if order.count("tick") == 3:  # by then the looks are timers-only ones
+            guard.trigger()
+            talker.publish(String(data="message"))
+
+    node.create_timer(0.05, tick)
+    assert spin_until(executor, lambda: "guard" in order and "message" in order), order
+    third = [i for i, what in enumerate(order) if what == "tick"][2]
+    assert order[third + 1] == "guard", order  # before the next tick (50 ms later)
+
+
+def test_timers_of_one_exclusive_group_keep_ticking_on_threads(ros):
+    # on a pool, a timer ends on another thread than the one that looked: the end must wake
+    # it, or a timer of the same group skipped as busy would wait for nothing
+    node = ros.Node("shared_group_ticks")
+    group = MutuallyExclusiveCallbackGroup()
+    runs = {"a": 0, "b": 0}
+
+    def counter(name: str) -> Callable[[], None]:
+        def count() -> None:
+            runs[name] += 1
+
+        return count
+
+    node.create_timer(0.01, counter("a"), callback_group=group)
+    node.create_timer(0.01, counter("b"), callback_group=group)
+    executor = MultiThreadedExecutor(num_threads=2)
+    executor.add_node(node)
+    spinner = Background(executor)
+    try:
+        done = wait_until(lambda: min(runs.values()) >= 20, BOUND)
+    finally:
+        spinner.stop()
+    assert done, runs
+
+
 def test_a_wait_given_a_change_count_ends_false_at_its_timeout_without_asking_ready(ros):
     participant = ros.Node("waiter").participant
     asked: list[int] = []
