@@ -101,6 +101,9 @@ class Executor:
         self._quiet: tuple[int, tuple[Node, ...]] | None = None
         self._fast: Any = None  # the timer the last timers-only look handed out
         self._fast_thread = 0  # the thread that looked
+        self._looks = 0  # whole looks and waits so far (a nested spin in a callback counts)
+        self._fast_looks = 0  # ... when the timer was handed out
+        self._looking = 0  # threads inside _next_work
 
     @property
     def context(self) -> Context:
@@ -342,6 +345,18 @@ class Executor:
         condition: Callable[[], bool] | None = None,
     ) -> tuple[Any, Node | None]:
         """The next task to resume, or entity to run (marked in flight); waits for one."""
+        self._looking += 1
+        try:
+            return self._look(timeout_sec, nodes, condition)
+        finally:
+            self._looking -= 1
+
+    def _look(
+        self,
+        timeout_sec: float | None,
+        nodes: Iterable[Node] | None,
+        condition: Callable[[], bool] | None,
+    ) -> tuple[Any, Node | None]:
         deadline = (
             None if timeout_sec is None or timeout_sec < 0 else time.monotonic() + timeout_sec
         )
@@ -400,6 +415,7 @@ class Executor:
                 time.sleep(0.05 if wait is None else min(wait, 0.05))
                 continue
             assert changes is not None  # (read from the participant)
+            self._looks += 1
             # ends on any change since `changes` was read, or at `wait`: then this loop looks
             if wait is None:
                 changed = participant.wait(_never, wait, changes)
@@ -415,6 +431,7 @@ class Executor:
         Entities come in rclpy's order per node. With ``into`` None, only say whether there
         are any.
         """
+        self._looks += 1
         found = False
         if self._ready_tasks:
             if into is None:
@@ -465,6 +482,7 @@ class Executor:
                     timer._executor_event = True  # not offered again until taken
                     self._fast = timer
                     self._fast_thread = threading.get_ident()
+                    self._fast_looks = self._looks
                     return timer, node
                 if clock._sim_ns is None and (soonest is None or until < soonest):
                     soonest = until  # (sim-time timers are woken by /clock arriving)
@@ -560,14 +578,17 @@ class Executor:
             participant = self._context.participant
             if (
                 idle
+                and self._looks == self._fast_looks
+                and not self._looking
                 and participant is not None
                 and participant.unwatched()
                 and threading.get_ident() == self._fast_thread
             ):
                 # a timer a timers-only look handed out, run by the thread that looked, with
-                # nothing else running and nobody waiting: its group is as free as at that
-                # look, so the next look may still ask only the timers (what its callback
-                # changed, it notified)
+                # nothing else running, nobody looking or waiting, and no look since (a
+                # nested spin in its callback may have passed over what its group held):
+                # the group is as free as at that look, so the next look may still ask only
+                # the timers (what its callback changed, it notified)
                 return
         self.wake()  # a mutually exclusive group is free again
 

@@ -28,13 +28,14 @@ from rosl.bus.header import HEADER_SIZE, MAGIC
 if TYPE_CHECKING:
     from collections.abc import Collection
 
-__all__ = ["MAX_HASHES", "attach", "detach", "program"]
+__all__ = ["MAX_HASHES", "attach", "detach", "most_hashes", "program"]
 
 SO_ATTACH_FILTER = 26  # linux/asm-generic/socket.h (not exported by the socket module)
 SO_DETACH_FILTER = 27
 UDP_HEADER = 8  # a UDP socket's filter sees the UDP header first, then the payload
 TOPIC_OFFSET = 20  # where the topic hash starts in rosl's header (see header.py)
 MAX_HASHES = 600  # 5 instructions each; the kernel takes programs up to 4096 instructions
+HASH_COST = 260  # bytes of socket option memory (net.core.optmem_max) a filter takes per hash
 
 _INSTRUCTION = struct.Struct("HBBI")  # struct sock_filter: code, jt, jf, k
 _LD_H = 0x28  # BPF_LD | BPF_H | BPF_ABS: A = 16-bit word at k (network order)
@@ -70,23 +71,43 @@ def program(hashes: Collection[int]) -> list[tuple[int, int, int, int]]:
     return code
 
 
-def attach(sock: socket.socket, hashes: Collection[int]) -> bool:
-    """Let only ``hashes`` (and foreign datagrams) into ``sock``; False if the OS refuses.
+def most_hashes() -> int:
+    """How many hashes one filter may hold here.
 
-    More than :data:`MAX_HASHES` hashes: no filter (everything comes in).
+    :data:`MAX_HASHES`, or fewer where the kernel's socket option memory
+    (``net.core.optmem_max``, 20 KiB before Linux 6.9) is small.
     """
-    if len(hashes) > MAX_HASHES:
-        return detach(sock)
+    try:
+        with open("/proc/sys/net/core/optmem_max", encoding="ascii") as handle:
+            budget = int(handle.read().strip())
+    except (OSError, ValueError):
+        return MAX_HASHES
+    return max(0, min(MAX_HASHES, budget * 2 // 5 // HASH_COST))  # leaves room for the rest
+
+
+def attach(sock: socket.socket, hashes: Collection[int]) -> bool:
+    """Let only ``hashes`` (and foreign datagrams) into ``sock``; False: no filter at all.
+
+    More hashes than :func:`most_hashes`, or a kernel that refuses the program: the socket
+    is left with no filter (everything comes in), never with an older one.
+    """
     if not sys.platform.startswith("linux"):
+        return False
+    if len(hashes) > _MOST:
+        detach(sock)
         return False
     code = program(hashes)
     instructions = ctypes.create_string_buffer(b"".join(_INSTRUCTION.pack(*i) for i in code))
+    # struct sock_fprog on 64-bit Linux (elsewhere the kernel refuses it: no filter)
     fprog = struct.pack("HxxxxxxQ", len(code), ctypes.addressof(instructions))
-    try:  # the kernel copies the program: the buffer may go once this returns
-        sock.setsockopt(socket.SOL_SOCKET, SO_ATTACH_FILTER, fprog)
-    except OSError:
-        return False
-    return True
+    for _ in range(2):  # the kernel copies the program: the buffer may go once this returns
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, SO_ATTACH_FILTER, fprog)
+        except OSError:
+            detach(sock)  # replacing charges the old program and the new one at once: again
+            continue
+        return True
+    return False
 
 
 def detach(sock: socket.socket) -> bool:
@@ -98,3 +119,6 @@ def detach(sock: socket.socket) -> bool:
     except OSError:
         return False
     return True
+
+
+_MOST = most_hashes()

@@ -529,8 +529,8 @@ class Supervisor:
             self.kill_all()
             self._close_zygote()
             if self._subreaper:  # the launch is over: this process (maybe a test's) is not
-                zygote.reap_orphans()  # a subreaper any longer
-                zygote.become_subreaper(False)
+                zygote.become_subreaper(False)  # a subreaper any longer (first: an orphan
+                zygote.reap_orphans()  # ending after the last reap would stay a zombie)
                 self._subreaper = False
             if installed_here:
                 self.restore_signal_handlers()

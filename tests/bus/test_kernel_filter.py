@@ -148,8 +148,28 @@ def test_the_program_keeps_exactly_the_wanted_hashes() -> None:
             seen.append(int.from_bytes(data[20:28], "little"))
         assert seen == sorted(wanted)
 
-        assert kernel_filter.attach(rx, set(range(kernel_filter.MAX_HASHES + 1)))  # too many
+        # too many for one filter here: none at all (not the one before, which would drop
+        # what was wanted since)
+        assert not kernel_filter.attach(rx, set(range(kernel_filter.most_hashes() + 1)))
         tx.sendto(
             bytes(head[:20]) + unwanted[0].to_bytes(8, "little") + bytes(20), rx.getsockname()
         )
         assert int.from_bytes(rx.recv(100)[20:28], "little") == unwanted[0]  # no filter now
+
+
+def test_a_channel_wanting_more_than_a_filter_holds_lets_everything_in(domain_id: int) -> None:
+    # the old, smaller filter must not stay: it would drop what was wanted since (review)
+    with quiet_and_busy(domain_id) as (receiver, quiet, busy, _):
+        first = [(quiet.channel - 1) + 64 * k for k in range(1, kernel_filter.most_hashes())]
+        receiver.reader.wanted.update(first)  # with the quiet topic: exactly as many as fit
+        receiver.poll(0.0, [])
+        busy.send(b"dropped")
+        quiet.send(b"marker 1")
+        assert [bytes(d.payload) for d in until_marker(receiver, b"marker 1")] == [b"marker 1"]
+
+        receiver.reader.wanted.update([first[-1] + 64, busy.topic])  # one filter too many
+        receiver.poll(0.0, [])
+        busy.send(b"now wanted")
+        quiet.send(b"marker 2")
+        got = until_marker(receiver, b"marker 2")
+        assert sorted(bytes(d.payload) for d in got) == [b"marker 2", b"now wanted"]

@@ -946,6 +946,27 @@ def test_what_a_timer_callback_makes_ready_runs_before_the_next_tick(ros):
     assert order[third + 1] == "guard", order  # before the next tick (50 ms later)
 
 
+def test_a_timer_that_spins_inside_its_callback_does_not_starve_its_groups_subscription(ros):
+    # the nested spin looks while the timer holds the group and passes over the message;
+    # the timer's end must then make the next look a whole one (review)
+    node, executor = settled(ros, "nested_spinner")
+    from rosl.idl.registry import get_message_class
+
+    String = get_message_class("std_msgs/msg/String")
+    heard: list[str] = []
+    node.create_subscription(String, "/nested_spin", lambda m: heard.append(m.data), 10)
+    talker = node.create_publisher(String, "/nested_spin", 10)
+    ticks: list[int] = []
+
+    def tick() -> None:
+        ticks.append(1)
+        talker.publish(String(data=f"m{len(ticks)}"))
+        executor.spin_once(timeout_sec=0.05)  # e.g. waiting a little for an answer
+
+    node.create_timer(0.1, tick)
+    assert spin_until(executor, lambda: len(heard) >= 5), (len(ticks), heard)
+
+
 def test_timers_of_one_exclusive_group_keep_ticking_on_threads(ros):
     # on a pool, a timer ends on another thread than the one that looked: the end must wake
     # it, or a timer of the same group skipped as busy would wait for nothing
