@@ -133,12 +133,23 @@ def tf_message(now_ns: int, transforms: Sequence[tuple[bytes, bytes, Sequence[fl
 
 
 @cache
-def joint_struct(names: tuple[bytes, ...]) -> struct.Struct:
+def joint_struct(names: tuple[bytes, ...], count: int | None = None) -> struct.Struct:
     """sensor_msgs/msg/JointState of these joints, an empty frame and no efforts.
 
     Its values: the encapsulation header, sec, nanosec, 1, b"", the count, each name's size
     and bytes, then the positions and the velocities (each its count, then the doubles), 0.
+    ``count``: how many positions and velocities (default: one per name).
     """
+    return _joint_layout(names, len(names) if count is None else count)[0].struct()
+
+
+@cache
+def joint_offsets(names: tuple[bytes, ...], count: int) -> tuple[int, int]:
+    """Where the positions' and the velocities' doubles start in :func:`joint_struct`'s bytes."""
+    return _joint_layout(names, count)[1]
+
+
+def _joint_layout(names: tuple[bytes, ...], count: int) -> tuple[_Layout, tuple[int, int]]:
     layout = _Layout()
     layout.format += "4s"
     layout.field("i", 4)
@@ -147,12 +158,16 @@ def joint_struct(names: tuple[bytes, ...]) -> struct.Struct:
     layout.field("I", 4)
     for name in names:
         layout.string(name)
+    offsets = []
     for _ in range(2):  # position, velocity
         layout.field("I", 4)
-        if names:
-            layout.field("d", 8, len(names))
+        if count:
+            layout.align(8)
+        offsets.append(len(HEADER) + layout.offset)  # counted in the bytes, header included
+        if count:
+            layout.field("d", 8, count)
     layout.field("I", 4)  # no efforts
-    return layout.struct()
+    return layout, (offsets[0], offsets[1])
 
 
 def joint_state(now_ns: int, names: Sequence[bytes], position: Sequence[float],
@@ -163,7 +178,7 @@ def joint_state(now_ns: int, names: Sequence[bytes], position: Sequence[float],
     for name in names:
         values += [len(name) + 1, name]
     values += [len(position), *position, len(velocity), *velocity, 0]
-    return joint_struct(tuple(names)).pack(*values)
+    return joint_struct(tuple(names), len(position)).pack(*values)
 
 
 @cache

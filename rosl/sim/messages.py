@@ -331,8 +331,26 @@ class RobotEncoder:
         ))  # fmt: skip
         self._odometry_offsets = (pose, pose + _ODOM_TWIST)
         self.joint_names = [j.encode() for j in model.joints]
-        self._joints = encode.joint_struct(tuple(self.joint_names)).pack
         self._names = tuple(v for name in self.joint_names for v in (len(name) + 1, name))
+        # joint states the same way: the joints the robot turns have values (the others none,
+        # as the message object's arrays are the robot's lists cut to the names' count)
+        robot = sim_robot.robot
+        self.robot = robot
+        names = tuple(self.joint_names)
+        values = min(len(names), len(robot.wheels))
+        self._whole = values == len(robot.wheels)  # the robot's lists go in as they are
+        self._values = values
+        self._joint_buffer = bytearray(encode.joint_struct(names, values).pack(
+            encode.HEADER, 0, 0, 1, b"", len(names), *self._names,
+            values, *[0.0] * values, values, *[0.0] * values, 0,
+        ))  # fmt: skip
+        positions, velocities = encode.joint_offsets(names, values)
+        # the positions, the velocities' count and padding, the velocities: one pack_into
+        gap = velocities - positions - 8 * values - 4
+        self._joint_values_into = (
+            struct.Struct(f"<{values}dI{gap}x{values}d").pack_into if values else None
+        )
+        self._joint_offset = positions
         index = {joint: k for k, joint in enumerate(model.joints)}
         self.wheels = [
             (frame.parent.encode(), frame.name.encode(), frame.xyz, quaternion(*frame.rpy),
@@ -372,7 +390,7 @@ class RobotEncoder:
 
         Its ``odom -> base`` transform's values are added to ``tf``.
         """
-        (x, y, yaw), (forward, turn) = self.sim_robot.robot.odometry()
+        x, y, yaw, forward, turn = self.robot.odometry_values()
         half = yaw / 2  # quaternion(0, 0, yaw)
         qz, qw = math.sin(half), math.cos(half)
         tf += (sec, nanosec, *self._frames, x, y, 0.0, 0.0, 0.0, qz, qw)
@@ -411,7 +429,7 @@ class RobotEncoder:
         The same numbers as :meth:`wheel_transforms` (its quaternion product, written out
         for a turn about z, with the same operations in the same order).
         """
-        angles = self.sim_robot.robot.wheels
+        angles = self.robot.wheels
         for head, (ax, ay, az, aw), joint in self._wheel_heads:
             if joint is not None and (spin := angles[joint]):
                 bz, bw = math.sin(spin / 2), math.cos(spin / 2)
@@ -431,13 +449,19 @@ class RobotEncoder:
 
     def joint_states_at(self, sec: int, nanosec: int) -> bytes:
         """sensor_msgs/JointState of the wheels as CDR, stamped ``sec``, ``nanosec``."""
-        robot = self.sim_robot.robot
-        count = len(self.joint_names)
-        position, velocity = robot.wheels[:count], robot.wheel_rates[:count]
-        return self._joints(
-            encode.HEADER, sec, nanosec, 1, b"", count, *self._names,
-            len(position), *position, len(velocity), *velocity, 0,
-        )  # fmt: skip
+        buffer = self._joint_buffer
+        _STAMP_INTO(buffer, 4, sec, nanosec)
+        values_into = self._joint_values_into
+        if values_into is not None:
+            robot = self.robot
+            if self._whole:
+                values_into(buffer, self._joint_offset, *robot.wheels, self._values,
+                            *robot.wheel_rates)  # fmt: skip
+            else:
+                count = self._values
+                values_into(buffer, self._joint_offset, *robot.wheels[:count], count,
+                            *robot.wheel_rates[:count])  # fmt: skip
+        return bytes(buffer)
 
     def laser_scan(self, lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:
         """sensor_msgs/LaserScan of one of the robot's LiDARs as CDR."""
