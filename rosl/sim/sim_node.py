@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import functools
 import math
+import operator
 import sys
 import time
 from dataclasses import dataclass, field
@@ -55,6 +56,7 @@ SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, 
 # paced: a topic's batch bound, so a millisecond's messages (~24 odometries of 720 bytes at
 # 800x real time) go as one datagram, built in one join (the bus caps it at a datagram's size)
 HELD_BYTES = 60000
+_DUE = operator.attrgetter("at_ns")  # a schedule's next due time
 
 
 class _Topic:
@@ -65,6 +67,7 @@ class _Topic:
         self.publisher = publisher
         self.always = always or sim_node._publish_all
         self._publish = publisher.publish
+        self._publish_all = publisher.publish_all
         self._pending: list[bytes] = []
 
     def wanted(self) -> bool:
@@ -89,7 +92,7 @@ class _Topic:
         """Publish what waits as the publisher's batch, and send it (its only messages)."""
         pending = self._pending
         if pending:
-            self.publisher.publish_all(pending, flush=True)
+            self._publish_all(pending, flush=True)
             pending.clear()
 
 
@@ -214,6 +217,7 @@ class SimNode:
             topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
             self.robots.append(topics)
         self._tf_packs: dict[tuple[int, ...], Callable[..., bytes]] = {}
+        self._clock_pack = functools.partial(encode.CLOCK.pack, encode.HEADER)  # (sec, nanosec)
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -306,8 +310,8 @@ class SimNode:
         if key and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
             pack = self._tf_packs.get(key) or self._tf_pack(key)
             tf.send(pack(*values))
-        self.clock.send(encode.CLOCK.pack(encode.HEADER, sec, nanosec))  # every step's data too
-        self._next_event = min([schedule.at_ns for schedule in self._schedules])
+        self.clock.send(self._clock_pack(sec, nanosec))  # every step's data too
+        self._next_event = min(map(_DUE, self._schedules))
 
     def _tf_pack(self, key: tuple[int, ...]) -> Callable[..., bytes]:
         """The packer of /tf of these robots' odometry (2 k) and wheels (2 k + 1) transforms.
@@ -384,6 +388,7 @@ class SimNode:
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
         """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
         sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
+        advance = sim.advance
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
         end = math.inf if end_ns is None else end_ns
@@ -408,10 +413,7 @@ class SimNode:
                 self._pace(started)
                 step()
             else:  # the steps that publish nothing run back to back, the clock unread
-                stop = min(self._next_event, end)
-                step()
-                while sim.now_ns < stop and sim.now_ns <= allowed:
-                    step()
+                advance(min(self._next_event, end), allowed)
             if sim.now_ns >= self._next_event:
                 tick()
 
