@@ -21,6 +21,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     import numpy as np
+else:
+    from rosl.idl.lazy_numpy import np
 
 HEADER = b"\x00\x01\x00\x00"
 NS = 1_000_000_000
@@ -207,3 +209,28 @@ def laser_scan(now_ns: int, frame: bytes, fields: Sequence[float], ranges: np.nd
         HEADER, sec, nanosec, len(frame) + 1, frame, *fields, len(ranges)
     )
     return head + ranges.astype("<f4", copy=False).tobytes() + _NO_INTENSITIES
+
+
+class ScanPacker:
+    """sensor_msgs/msg/LaserScan of one LiDAR, as :func:`laser_scan`, its fixed part packed once.
+
+    Called with a scan's stamp and ranges (float32): the stamp and the count are written into
+    the prepared head, which is joined with the ranges' bytes and the empty intensities.
+    """
+
+    def __init__(self, frame: bytes, fields: Sequence[float]) -> None:
+        layout = _scan_layout(frame)
+        self._head = bytearray(layout.pack(HEADER, 0, 0, len(frame) + 1, frame, *fields, 0))
+        self._count = layout.size - 4  # where the ranges' count is
+
+    def __call__(self, sec: int, nanosec: int, ranges: np.ndarray) -> bytes:
+        """The scan stamped ``sec``, ``nanosec``, of these ranges, as CDR."""
+        head = self._head
+        _STAMP_INTO(head, len(HEADER), sec, nanosec)
+        _COUNT_INTO(head, self._count, len(ranges))
+        data = np.ascontiguousarray(ranges, dtype="<f4").data  # (the scan's own, no copy)
+        return b"".join((head, data, _NO_INTENSITIES))
+
+
+_STAMP_INTO = struct.Struct("<iI").pack_into
+_COUNT_INTO = struct.Struct("<I").pack_into

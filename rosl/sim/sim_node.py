@@ -16,10 +16,12 @@ messages go out before ``/clock``, so a timer woken by the new time sees the ste
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
 
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
-messages wait in their topic's list, which this thread publishes as one batch once a
-millisecond of wall time and before it sleeps (sensors first, ``/clock`` last; no timer thread
-contends for the GIL), and the bus is served at that pace rather than every step: a datagram,
-or even a publish call, per step per topic would cost more than the physics. Lock-step and
+messages wait in their topic's list, which this thread publishes as one batch before it sleeps
+(sensors first, ``/clock`` last; no timer thread contends for the GIL) and, when it never
+sleeps (running flat out, above what the pace asks), every two milliseconds of wall time; the
+bus is looked at (cmd_vel, parameters) once a millisecond rather than every step: a datagram,
+or even a publish call, per step per topic would cost more than the physics, and a flush of
+the batches (framing, MACs, one send each) costs about thirty physics steps. Lock-step and
 recording keep one datagram per message and serve the bus every step.
 """
 
@@ -36,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.sim import encode
 from rosl.sim import messages as build
+from rosl.sim.messages import MESSAGE, NOT_DUE, TRANSFORM
 from rosl.sim.report import RobotReport, SimReport
 from rosl.sim.simulation import Schedule
 
@@ -47,13 +50,15 @@ if TYPE_CHECKING:
     from rosl.node.lockstep import LockstepSource
     from rosl.node.node import Node
     from rosl.node.publisher import Publisher
+    from rosl.sim.encode import ScanPacker
     from rosl.sim.options import SimOptions
     from rosl.sim.simulation import SimRobot, Simulation
     from rosl.sim.worldfile import Lidar
 
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
-# paced: a topic's batch bound, so a millisecond's messages (~24 odometries of 720 bytes at
+FLUSH_EVERY_S = 0.002  # paced, flat out: wall seconds between sends of the batches
+# paced: a topic's batch bound, so two milliseconds' messages (~48 odometries of 720 bytes at
 # 800x real time) go as one datagram, built in one join (the bus caps it at a datagram's size)
 HELD_BYTES = 60000
 _DUE = operator.attrgetter("at_ns")  # a schedule's next due time
@@ -104,7 +109,8 @@ class _RobotTopics:
     scans: list[_Topic]
     description: Publisher
     encoder: build.RobotEncoder
-    lidars: list[tuple[Lidar, Schedule, _Topic]] = field(default_factory=list)
+    # each LiDAR with its schedule, topic and packer (see RobotEncoder.scan_packer)
+    lidars: list[tuple[Lidar, Schedule, _Topic, ScanPacker]] = field(default_factory=list)
     odom_key: int = 0  # this robot's odometry transform in a tick's /tf (see SimNode._tf_pack)
     wheel_key: int = 0  # and its wheels'
 
@@ -212,7 +218,8 @@ class SimNode:
                 sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
             )
             topics.lidars = [
-                (lidar, s, t) for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
+                (lidar, s, t, topics.encoder.scan_packer(lidar))
+                for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
             ]
             topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
             self.robots.append(topics)
@@ -279,33 +286,37 @@ class SimNode:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
             odom = sim_robot.odom
+            odometry = wheels = NOT_DUE
             if now >= odom.at_ns:
                 odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
                 topic = topics.odom
-                wanted = topic.always or topic.wanted()
-                message = encoder.odometry_at(sec, nanosec, values, wanted)
-                if wanted:
-                    topic.send(message)
+                odometry = MESSAGE if topic.always or topic.wanted() else TRANSFORM
                 key += (topics.odom_key,)
             joints = sim_robot.joints
+            states_topic = topics.joints
             if joints is not None and now >= joints.at_ns:
                 joints.fire(now)
-                topic_or_none = topics.joints
-                if topic_or_none is not None and (topic_or_none.always or topic_or_none.wanted()):
-                    topic_or_none.send(encoder.joint_states_at(sec, nanosec))
-                encoder.wheels_at(sec, nanosec, values)
+                wheels = TRANSFORM
+                if states_topic is not None and (states_topic.always or states_topic.wanted()):
+                    wheels = MESSAGE
                 key += (topics.wheel_key,)
-            for lidar, schedule, topic in topics.lidars:
+            if odometry or wheels:  # one call for both (their messages, b"" where none)
+                message, states = encoder.tick_at(sec, nanosec, values, odometry, wheels)
+                if odometry == MESSAGE:
+                    topics.odom.send(message)
+                if states_topic is not None and wheels == MESSAGE:
+                    states_topic.send(states)
+            for lidar, schedule, topic, scan_bytes in topics.lidars:
                 if now >= schedule.at_ns:
                     index = schedule.fire(now)
                     wanted = topic.always or topic.wanted()
                     if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if wanted:
-                            topic.send(encoder.laser_scan(lidar, ranges, now))
+                            topic.send(scan_bytes(sec, nanosec, ranges))
         tf = self.tf
         if key and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
             pack = self._tf_packs.get(key) or self._tf_pack(key)
@@ -386,18 +397,24 @@ class SimNode:
         return self._finish(wall)
 
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
-        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
+        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond.
+
+        The batches go out every :data:`FLUSH_EVERY_S` when the loop never waits (flat out);
+        when it does, before each wait (see :meth:`_pace`).
+        """
         sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
         advance = sim.advance
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
         end = math.inf if end_ns is None else end_ns
         status_at = started + 1.0
-        serve_at = 0.0
+        serve_at = flush_at = 0.0
         while True:
             wall = monotonic()
             if wall >= serve_at:
-                self._flush()
+                if wall >= flush_at:
+                    self._flush()
+                    flush_at = wall + FLUSH_EVERY_S
                 if not context.ok():
                     return
                 self.executor.spin_some()  # /cmd_vel, parameters
