@@ -18,10 +18,10 @@ With ``record``, an in-process recorder writes the bus to MCAP with sim-time log
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
 messages wait in their topic's list, which this thread publishes as one batch before it sleeps
 (sensors first, ``/clock`` last; no timer thread contends for the GIL) and, when it never
-sleeps (running flat out, above what the pace asks), every two milliseconds of wall time; the
+sleeps (running flat out, above what the pace asks), every four milliseconds of wall time; the
 bus is looked at (cmd_vel, parameters) once a millisecond rather than every step: a datagram,
 or even a publish call, per step per topic would cost more than the physics, and a flush of
-the batches (framing, MACs, one send each) costs about thirty physics steps. Lock-step and
+the batches (framing, MACs, one send each) costs some thirty physics steps. Lock-step and
 recording keep one datagram per message and serve the bus every step.
 """
 
@@ -57,9 +57,9 @@ if TYPE_CHECKING:
 
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
-FLUSH_EVERY_S = 0.002  # paced, flat out: wall seconds between sends of the batches
-# paced: a topic's batch bound, so two milliseconds' messages (~48 odometries of 720 bytes at
-# 800x real time) go as one datagram, built in one join (the bus caps it at a datagram's size)
+FLUSH_EVERY_S = 0.004  # paced, flat out: wall seconds between sends of the batches
+# paced: a topic's batch bound, near a datagram's size (the bus caps it there): 4 ms of
+# odometry at 700x real time (~84 of 736 bytes) fills one, more goes in further datagrams
 HELD_BYTES = 60000
 _DUE = operator.attrgetter("at_ns")  # a schedule's next due time
 
@@ -113,6 +113,9 @@ class _RobotTopics:
     lidars: list[tuple[Lidar, Schedule, _Topic, ScanPacker]] = field(default_factory=list)
     odom_key: int = 0  # this robot's odometry transform in a tick's /tf (see SimNode._tf_pack)
     wheel_key: int = 0  # and its wheels'
+    # the joint states at the odometry's rate: both schedules fall due at the same ticks and
+    # fire alike from the same start, so the joints' takes the odometry's firing
+    twin: bool = False
 
 
 class SimNode:
@@ -222,6 +225,11 @@ class SimNode:
                 for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
             ]
             topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
+            joints_schedule = sim_robot.joints
+            topics.twin = joints_schedule is not None and (
+                (joints_schedule.rate, joints_schedule.index)
+                == (sim_robot.odom.rate, sim_robot.odom.index)
+            )
             self.robots.append(topics)
         self._tf_packs: dict[tuple[int, ...], Callable[..., bytes]] = {}
         self._clock_pack = functools.partial(encode.CLOCK.pack, encode.HEADER)  # (sec, nanosec)
@@ -298,7 +306,10 @@ class SimNode:
             joints = sim_robot.joints
             states_topic = topics.joints
             if joints is not None and now >= joints.at_ns:
-                joints.fire(now)
+                if topics.twin:  # the odometry's firing, just taken: the same numbers
+                    joints.index, joints.at_ns = odom.index, odom.at_ns
+                else:
+                    joints.fire(now)
                 wheels = TRANSFORM
                 if states_topic is not None and (states_topic.always or states_topic.wanted()):
                     wheels = MESSAGE
