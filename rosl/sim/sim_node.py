@@ -19,10 +19,11 @@ Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py
 messages wait in their topic's list, which this thread publishes as one batch before it sleeps
 (sensors first, ``/clock`` last; no timer thread contends for the GIL) and, when it never
 sleeps (running flat out, above what the pace asks), every four milliseconds of wall time; the
-bus is looked at (cmd_vel, parameters) once a millisecond rather than every step: a datagram,
-or even a publish call, per step per topic would cost more than the physics, and a flush of
-the batches (framing, MACs, one send each) costs some thirty physics steps. Lock-step and
-recording keep one datagram per message and serve the bus every step.
+bus is looked at (cmd_vel, parameters) before each wait and, flat out, every two milliseconds,
+rather than every step: a datagram, or even a publish call, per step per topic would cost more
+than the physics, a flush of the batches (framing, MACs, one send each) some thirty physics
+steps and a look at the bus about five. Lock-step and recording keep one datagram per message
+and serve the bus every step.
 """
 
 from __future__ import annotations
@@ -56,7 +57,7 @@ if TYPE_CHECKING:
     from rosl.sim.worldfile import Lidar
 
 NS = 1_000_000_000
-SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
+SERVE_EVERY_S = 0.002  # paced, flat out: wall seconds between looks at the bus (cmd_vel, ...)
 FLUSH_EVERY_S = 0.004  # paced, flat out: wall seconds between sends of the batches
 # paced: a topic's batch bound, near a datagram's size (the bus caps it there): 4 ms of
 # odometry at 700x real time (~84 of 736 bytes) fills one, more goes in further datagrams
@@ -408,10 +409,12 @@ class SimNode:
         return self._finish(wall)
 
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
-        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond.
+        """The paced loop: the bus, its batches, Ctrl-C and the status line.
 
-        The batches go out every :data:`FLUSH_EVERY_S` when the loop never waits (flat out);
-        when it does, before each wait (see :meth:`_pace`).
+        When the loop never waits (flat out), the bus is looked at every
+        :data:`SERVE_EVERY_S` and the batches go out every :data:`FLUSH_EVERY_S`; when it
+        waits, both happen before each wait, and the bus is served throughout (see
+        :meth:`_pace`).
         """
         sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
         advance = sim.advance
