@@ -59,9 +59,9 @@ if TYPE_CHECKING:
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.002  # paced, flat out: wall seconds between looks at the bus (cmd_vel, ...)
 FLUSH_EVERY_S = 0.004  # paced, flat out: wall seconds between sends of the batches
-# paced: a topic's batch bound, near a datagram's size (the bus caps it there): 4 ms of
-# odometry at 700x real time (~84 of 736 bytes) fills one, more goes in further datagrams
-HELD_BYTES = 60000
+# paced: a topic's batch bound, a datagram's size (the bus caps it there): 4 ms of odometry at
+# 700x real time (~84 of 736 bytes) fills one, more goes in further datagrams
+HELD_BYTES = 65000
 _DUE = operator.attrgetter("at_ns")  # a schedule's next due time
 
 
