@@ -95,20 +95,28 @@ class Batch:
         messages in one call. A full batch of a run alone goes as it is, with no copy.
         """
         size, limit = RECORD.size, self.limit
-        ends = list(accumulate(map(add, sizes, repeat(size))))  # framed bytes up to each one
         count = len(payloads)
+        total = size * count + sum(sizes)
+        ends: list[int] = []  # framed bytes up to each record (when they do not all fit)
         start = done = 0  # the first record of the next run, the framed bytes before it
         timed = bool(self._records)  # the flusher knows of what waits (told when it begins)
         while start < count:
-            end = bisect_right(ends, done + limit - len(self._records), start)
-            if end == start and self._records:  # the next does not fit beside what waits
-                self._flush_locked()
-                timed = False
-                continue
-            end = max(end, start + 1)  # (one too big for any batch still goes, alone)
+            if len(self._records) + total - done <= limit:  # the rest fits (the usual case)
+                end = count
+            else:
+                ends = ends or list(accumulate(map(add, sizes, repeat(size))))
+                end = bisect_right(ends, done + limit - len(self._records), start)
+                if end == start and self._records:  # the next does not fit beside what waits
+                    self._flush_locked()
+                    timed = False
+                    continue
+                end = max(end, start + 1)  # (one too big for any batch still goes, alone)
+            whole = start == 0 and end == count
+            run_sizes = sizes if whole else sizes[start:end]
+            run = payloads if whole else payloads[start:end]
             heads = map(RECORD.pack, range(first_seq + start, first_seq + end), repeat(stamp),
-                        sizes[start:end])  # fmt: skip
-            joined = b"".join(chain.from_iterable(zip(heads, payloads[start:end], strict=True)))
+                        run_sizes)  # fmt: skip
+            joined = b"".join(chain.from_iterable(zip(heads, run, strict=True)))
             if not self._records and (end < count or flush):  # full, or asked: it goes now
                 self._send(first_seq + start, stamp, joined)
             else:
@@ -117,7 +125,7 @@ class Batch:
                 if end < count:  # full: the next run starts a new batch
                     self._flush_locked()
                     timed = False
-            start, done = end, ends[end - 1]
+            start, done = end, (ends[end - 1] if ends else total)
         if self._records and (flush or not timed):  # asked, or the flusher has closed
             self._flush_locked()
 
