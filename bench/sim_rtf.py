@@ -1,8 +1,8 @@
 """Simulator speed: real-time factor headless, and in lock-step with a controller process.
 
-    .venv/bin/python bench/sim_rtf.py [--seconds 60] [--runs 3] [--previous /path/to/older/checkout]
+    .venv/bin/python bench/sim_rtf.py [--seconds 60] [--runs 5] [--previous /path/to/older/checkout]
 
-Rows (median of ``--runs``, 3 by default):
+Rows (median of ``--runs``, 5 by default):
   core        physics + scans + odometry bookkeeping, no messages (the ceiling)
   node        the sim node publishing every topic to the bus (as if all were subscribed)
   node-720    the same with a 10 Hz x 720-ray LiDAR
@@ -146,7 +146,7 @@ def previous_core(tree: Path, seconds: float, runs: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--seconds", type=float, default=60.0)
-    parser.add_argument("--runs", type=int, default=3, help="runs per row (the median counts)")
+    parser.add_argument("--runs", type=int, default=5, help="runs per row (the median counts)")
     parser.add_argument("--previous", type=Path, help="a checkout of the previous implementation")
     parser.add_argument("--core-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
