@@ -361,7 +361,7 @@ class RobotEncoder:
         ]  # fmt: skip
         self.wheel_key = tuple((parent, child) for parent, child, *_ in self.wheels)
         turning = len(sim_robot.robot.wheels)  # the joints the robot turns (the others: 0)
-        self._wheel_heads = [
+        self._wheel_heads = [  # the frames and offset, the fixed rotation, the joint turning it
             ((len(parent) + 1, parent, len(child) + 1, child, *xyz), rotation,
              joint if joint is not None and joint < turning else None)
             for parent, child, xyz, rotation, joint in self.wheels
@@ -408,7 +408,9 @@ class RobotEncoder:
             x, y, yaw, forward, turn = self.robot.odometry_values()
             half = yaw / 2  # quaternion(0, 0, yaw)
             qz, qw = math.sin(half), math.cos(half)
-            tf += (sec, nanosec, *self._frames, x, y, 0.0, 0.0, 0.0, qz, qw)
+            tf += (sec, nanosec)  # (three extends: no tuple built around the frames)
+            tf += self._frames
+            tf += (x, y, 0.0, 0.0, 0.0, qz, qw)
             if odometry == MESSAGE:
                 buffer = self._odometry_buffer
                 pose, twist = self._odometry_offsets
