@@ -18,7 +18,7 @@ With ``record``, an in-process recorder writes the bus to MCAP with sim-time log
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
 messages wait in their topic's list, which this thread publishes as one batch before it sleeps
 (sensors first, ``/clock`` last; no timer thread contends for the GIL) and, when it never
-sleeps (running flat out, above what the pace asks), every four milliseconds of wall time; the
+sleeps (running flat out, above what the pace asks), every eight milliseconds of wall time; the
 bus is looked at (cmd_vel, parameters) before each wait and, flat out, every two milliseconds,
 rather than every step: a datagram, or even a publish call, per step per topic would cost more
 than the physics, a flush of the batches (framing, MACs, one send each) some thirty physics
@@ -58,9 +58,9 @@ if TYPE_CHECKING:
 
 NS = 1_000_000_000
 SERVE_EVERY_S = 0.002  # paced, flat out: wall seconds between looks at the bus (cmd_vel, ...)
-FLUSH_EVERY_S = 0.004  # paced, flat out: wall seconds between sends of the batches
-# paced: a topic's batch bound, a datagram's size (the bus caps it there): 4 ms of odometry at
-# 700x real time (~84 of 736 bytes) fills one, more goes in further datagrams
+FLUSH_EVERY_S = 0.008  # paced, flat out: wall seconds between sends of the batches
+# paced: a topic's batch bound, a datagram's size (the bus caps it there): 8 ms of odometry at
+# 700x real time (~170 of 736 bytes) go in three
 HELD_BYTES = 65000
 _DUE = operator.attrgetter("at_ns")  # a schedule's next due time
 
