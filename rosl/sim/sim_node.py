@@ -21,9 +21,9 @@ messages wait in their topic's list, which this thread publishes as one batch be
 sleeps (running flat out, above what the pace asks), every eight milliseconds of wall time; the
 bus is looked at (cmd_vel, parameters) before each wait and, flat out, every two milliseconds,
 rather than every step: a datagram, or even a publish call, per step per topic would cost more
-than the physics, a flush of the batches (framing, MACs, one send each) some thirty physics
-steps and a look at the bus about five. Lock-step and recording keep one datagram per message
-and serve the bus every step.
+than the physics, and each flush (framing, MACs, a send per batch) and each look at the bus
+has a fixed cost of tens of microseconds, which a longer interval spreads over more steps.
+Lock-step and recording keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
