@@ -104,6 +104,7 @@ class Executor:
         self._looks = 0  # whole looks and waits so far (a nested spin in a callback counts)
         self._fast_looks = 0  # ... when the timer was handed out
         self._looking = 0  # threads inside _next_work
+        self._idle_at: int | None = None  # the participant's changes when a look found nothing
 
     @property
     def context(self) -> Context:
@@ -244,12 +245,48 @@ class Executor:
 
         As rclcpp's ``spin_some``: what becomes ready while these run waits for the next call.
         """
+        participant = self._context.participant
+        if not timeout_sec and participant is not None and self._still_idle(participant):
+            return 0
+        before = None if participant is None else participant.changes
         ran = 0
         wait: float | None = timeout_sec
         while self._spin_one(wait):
             ran += 1
             wait = 0.0
+        if not ran and participant is not None and participant.changes == before:
+            self._idle_at = before  # nothing was ready, and nothing has changed since the look
         return ran
+
+    def _still_idle(self, participant: Participant) -> bool:
+        """Whether a ``spin_some`` would find nothing: as at its last empty look, with no news.
+
+        Everything but time that makes an entity ready or runnable says so through the
+        participant's ``changes`` (see :meth:`_next_work`); so when they have not moved since a
+        look that found nothing, only the due timers and the transport need a look: what it
+        holds is dispatched now, and any delivery moves ``changes`` again. A quiet look of a
+        bus-driven node (the simulator's, once a millisecond) costs a poll, not a walk over
+        every entity.
+        """
+        answerer = participant.answerer  # an idle look answers simulators that it has heard
+        if (
+            self._idle_at != participant.changes
+            or self._batch
+            or self._ready_tasks
+            or self._is_shutdown
+            or participant.closed
+            or not self._context.ok()
+            or (self.answers_lockstep and (answerer is None or answerer.seen))
+        ):
+            return False
+        for node in self._nodes:
+            if node.waitables:  # their readiness is their own: look at them the usual way
+                return False
+            for timer in node.timers:
+                if timer._ready() and self.can_execute(timer):
+                    return False
+        participant.poll(0.0)
+        return self._idle_at == participant.changes
 
     def spin_until_future_complete(
         self, future: Future[Any], timeout_sec: float | None = None

@@ -17,7 +17,9 @@ from __future__ import annotations
 
 import struct
 import threading
-from itertools import chain, repeat
+from bisect import bisect_right
+from itertools import accumulate, chain, repeat
+from operator import add
 from typing import TYPE_CHECKING
 
 from rosl.errors import RoslError
@@ -69,20 +71,10 @@ class Batch:
         count = len(payloads)
         sizes = list(map(len, payloads))
         with self._lock:
-            if (
-                len(self._records) + size * count + sum(sizes) <= limit
-                and first_seq + count <= 0x100000000
-            ):  # all fit, no number wraps: the records are built with no Python loop
-                heads = map(pack, range(first_seq, first_seq + count), repeat(stamp), sizes)
-                joined = b"".join(chain.from_iterable(zip(heads, payloads, strict=True)))
-                if flush and not self._records:  # the batch is these alone: it goes as it is
-                    self._send(first_seq, stamp, joined)
-                    return
-                timed = bool(self._records) or self._flusher.due(self)
-                self._records += joined
-                payloads = []
-            else:
-                timed = bool(self._records) or self._flusher.due(self)
+            if first_seq + count <= 0x100000000:  # no number wraps: runs framed with no loop
+                self._add_runs(first_seq, stamp, payloads, sizes, flush)
+                return
+            timed = bool(self._records) or self._flusher.due(self)
             for offset, payload in enumerate(payloads):
                 if len(self._records) + size + len(payload) > limit:
                     self._flush_locked()
@@ -92,6 +84,50 @@ class Batch:
                 records += payload
             if flush or not timed:  # asked, or the flusher has closed: nothing would send it
                 self._flush_locked()
+
+    def _add_runs(
+        self, first_seq: int, stamp: int, payloads: list[bytes], sizes: list[int], flush: bool
+    ) -> None:
+        """:meth:`add_all`'s records, in runs that each fill what the batch has room for.
+
+        The same batches as one :meth:`add` each (a batch is sent when the next record would
+        not fit), but each run's record heads are packed by ``map`` and joined with the
+        messages in one call. A full batch of a run alone goes as it is, with no copy.
+        """
+        size, limit = RECORD.size, self.limit
+        count = len(payloads)
+        total = size * count + sum(sizes)
+        ends: list[int] = []  # framed bytes up to each record (when they do not all fit)
+        start = done = 0  # the first record of the next run, the framed bytes before it
+        timed = bool(self._records)  # the flusher knows of what waits (told when it begins)
+        while start < count:
+            if len(self._records) + total - done <= limit:  # the rest fits (the usual case)
+                end = count
+            else:
+                ends = ends or list(accumulate(map(add, sizes, repeat(size))))
+                end = bisect_right(ends, done + limit - len(self._records), start)
+                if end == start and self._records:  # the next does not fit beside what waits
+                    self._flush_locked()
+                    timed = False
+                    continue
+                end = max(end, start + 1)  # (one too big for any batch still goes, alone)
+            whole = start == 0 and end == count
+            run_sizes = sizes if whole else sizes[start:end]
+            run = payloads if whole else payloads[start:end]
+            heads = map(RECORD.pack, range(first_seq + start, first_seq + end), repeat(stamp),
+                        run_sizes)  # fmt: skip
+            joined = b"".join(chain.from_iterable(zip(heads, run, strict=True)))
+            if not self._records and (end < count or flush):  # full, or asked: it goes now
+                self._send(first_seq + start, stamp, joined)
+            else:
+                timed = timed or self._flusher.due(self)
+                self._records += joined
+                if end < count:  # full: the next run starts a new batch
+                    self._flush_locked()
+                    timed = False
+            start, done = end, (ends[end - 1] if ends else total)
+        if self._records and (flush or not timed):  # asked, or the flusher has closed
+            self._flush_locked()
 
     def flush(self) -> None:
         """Send what is pending now."""

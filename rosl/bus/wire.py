@@ -264,7 +264,11 @@ class Writer:
             _MAGIC, _VERSION, self.kind, _BATCH | self._signed, 1, self.sender, seq,
             self.topic, self.type, 0, self.endpoint, len(records), stamp,
         )  # fmt: skip
-        self._send([head, records])
+        auth = self.auth  # (what _send does, one call less: a batch is sent once a millisecond)
+        parts: list[Buffer] = [head, records]
+        if auth is not None:
+            parts.append(auth.mac_parts(parts))
+        self.transport.send(self.channel, parts)
 
     def _send(self, parts: list[Buffer]) -> None:
         """Send one datagram, with its MAC when there is a key."""

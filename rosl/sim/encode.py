@@ -21,6 +21,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     import numpy as np
+else:
+    from rosl.idl.lazy_numpy import np
 
 HEADER = b"\x00\x01\x00\x00"
 NS = 1_000_000_000
@@ -133,12 +135,23 @@ def tf_message(now_ns: int, transforms: Sequence[tuple[bytes, bytes, Sequence[fl
 
 
 @cache
-def joint_struct(names: tuple[bytes, ...]) -> struct.Struct:
+def joint_struct(names: tuple[bytes, ...], count: int | None = None) -> struct.Struct:
     """sensor_msgs/msg/JointState of these joints, an empty frame and no efforts.
 
     Its values: the encapsulation header, sec, nanosec, 1, b"", the count, each name's size
     and bytes, then the positions and the velocities (each its count, then the doubles), 0.
+    ``count``: how many positions and velocities (default: one per name).
     """
+    return _joint_layout(names, len(names) if count is None else count)[0].struct()
+
+
+@cache
+def joint_offsets(names: tuple[bytes, ...], count: int) -> tuple[int, int]:
+    """Where the positions' and the velocities' doubles start in :func:`joint_struct`'s bytes."""
+    return _joint_layout(names, count)[1]
+
+
+def _joint_layout(names: tuple[bytes, ...], count: int) -> tuple[_Layout, tuple[int, int]]:
     layout = _Layout()
     layout.format += "4s"
     layout.field("i", 4)
@@ -147,12 +160,16 @@ def joint_struct(names: tuple[bytes, ...]) -> struct.Struct:
     layout.field("I", 4)
     for name in names:
         layout.string(name)
+    offsets = []
     for _ in range(2):  # position, velocity
         layout.field("I", 4)
-        if names:
-            layout.field("d", 8, len(names))
+        if count:
+            layout.align(8)
+        offsets.append(len(HEADER) + layout.offset)  # counted in the bytes, header included
+        if count:
+            layout.field("d", 8, count)
     layout.field("I", 4)  # no efforts
-    return layout.struct()
+    return layout, (offsets[0], offsets[1])
 
 
 def joint_state(now_ns: int, names: Sequence[bytes], position: Sequence[float],
@@ -163,7 +180,7 @@ def joint_state(now_ns: int, names: Sequence[bytes], position: Sequence[float],
     for name in names:
         values += [len(name) + 1, name]
     values += [len(position), *position, len(velocity), *velocity, 0]
-    return joint_struct(tuple(names)).pack(*values)
+    return joint_struct(tuple(names), len(position)).pack(*values)
 
 
 @cache
@@ -192,3 +209,28 @@ def laser_scan(now_ns: int, frame: bytes, fields: Sequence[float], ranges: np.nd
         HEADER, sec, nanosec, len(frame) + 1, frame, *fields, len(ranges)
     )
     return head + ranges.astype("<f4", copy=False).tobytes() + _NO_INTENSITIES
+
+
+class ScanPacker:
+    """sensor_msgs/msg/LaserScan of one LiDAR, as :func:`laser_scan`, its fixed part packed once.
+
+    Called with a scan's stamp and ranges (float32): the stamp and the count are written into
+    the prepared head, which is joined with the ranges' bytes and the empty intensities.
+    """
+
+    def __init__(self, frame: bytes, fields: Sequence[float]) -> None:
+        layout = _scan_layout(frame)
+        self._head = bytearray(layout.pack(HEADER, 0, 0, len(frame) + 1, frame, *fields, 0))
+        self._count = layout.size - 4  # where the ranges' count is
+
+    def __call__(self, sec: int, nanosec: int, ranges: np.ndarray) -> bytes:
+        """The scan stamped ``sec``, ``nanosec``, of these ranges, as CDR."""
+        head = self._head
+        _STAMP_INTO(head, len(HEADER), sec, nanosec)
+        _COUNT_INTO(head, self._count, len(ranges))
+        data = np.ascontiguousarray(ranges, dtype="<f4").data  # (the scan's own, no copy)
+        return b"".join((head, data, _NO_INTENSITIES))
+
+
+_STAMP_INTO = struct.Struct("<iI").pack_into
+_COUNT_INTO = struct.Struct("<I").pack_into

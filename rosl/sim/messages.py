@@ -300,6 +300,7 @@ def clock_bytes(now_ns: int) -> bytes:
 
 
 Transform = tuple[bytes, bytes, tuple[float, ...]]
+NOT_DUE, TRANSFORM, MESSAGE = 0, 1, 2  # what RobotEncoder.tick_at makes of odometry, wheels
 
 
 class RobotEncoder:
@@ -331,8 +332,26 @@ class RobotEncoder:
         ))  # fmt: skip
         self._odometry_offsets = (pose, pose + _ODOM_TWIST)
         self.joint_names = [j.encode() for j in model.joints]
-        self._joints = encode.joint_struct(tuple(self.joint_names)).pack
         self._names = tuple(v for name in self.joint_names for v in (len(name) + 1, name))
+        # joint states the same way: the joints the robot turns have values (the others none,
+        # as the message object's arrays are the robot's lists cut to the names' count)
+        robot = sim_robot.robot
+        self.robot = robot
+        names = tuple(self.joint_names)
+        values = min(len(names), len(robot.wheels))
+        self._whole = values == len(robot.wheels)  # the robot's lists go in as they are
+        self._values = values
+        self._joint_buffer = bytearray(encode.joint_struct(names, values).pack(
+            encode.HEADER, 0, 0, 1, b"", len(names), *self._names,
+            values, *[0.0] * values, values, *[0.0] * values, 0,
+        ))  # fmt: skip
+        positions, velocities = encode.joint_offsets(names, values)
+        # the positions, the velocities' count and padding, the velocities: one pack_into
+        gap = velocities - positions - 8 * values - 4
+        self._joint_values_into = (
+            struct.Struct(f"<{values}dI{gap}x{values}d").pack_into if values else None
+        )
+        self._joint_offset = positions
         index = {joint: k for k, joint in enumerate(model.joints)}
         self.wheels = [
             (frame.parent.encode(), frame.name.encode(), frame.xyz, quaternion(*frame.rpy),
@@ -342,7 +361,7 @@ class RobotEncoder:
         ]  # fmt: skip
         self.wheel_key = tuple((parent, child) for parent, child, *_ in self.wheels)
         turning = len(sim_robot.robot.wheels)  # the joints the robot turns (the others: 0)
-        self._wheel_heads = [
+        self._wheel_heads = [  # the frames and offset, the fixed rotation, the joint turning it
             ((len(parent) + 1, parent, len(child) + 1, child, *xyz), rotation,
              joint if joint is not None and joint < turning else None)
             for parent, child, xyz, rotation, joint in self.wheels
@@ -372,18 +391,63 @@ class RobotEncoder:
 
         Its ``odom -> base`` transform's values are added to ``tf``.
         """
-        (x, y, yaw), (forward, turn) = self.sim_robot.robot.odometry()
-        half = yaw / 2  # quaternion(0, 0, yaw)
-        qz, qw = math.sin(half), math.cos(half)
-        tf += (sec, nanosec, *self._frames, x, y, 0.0, 0.0, 0.0, qz, qw)
-        if not message:
-            return b""
-        buffer = self._odometry_buffer
-        pose, twist = self._odometry_offsets
-        _STAMP_INTO(buffer, 4, sec, nanosec)  # after the encapsulation header
-        _POSE_INTO(buffer, pose, x, y, qz, qw)
-        _TWIST_INTO(buffer, twist, forward, turn)
-        return bytes(buffer)
+        return self.tick_at(sec, nanosec, tf, MESSAGE if message else TRANSFORM, NOT_DUE)[0]
+
+    def tick_at(
+        self, sec: int, nanosec: int, tf: list[object], odometry: int, wheels: int
+    ) -> tuple[bytes, bytes]:
+        """A tick's odometry and wheels in one call: their messages (b"" where none).
+
+        Each of ``odometry`` and ``wheels`` is :data:`NOT_DUE`, :data:`TRANSFORM` (its
+        transforms' values are added to ``tf``: ``odom -> base``, then the wheel links) or
+        :data:`MESSAGE` (its message too: nav_msgs/Odometry, sensor_msgs/JointState). The
+        sim node's tick, where both fall due together, so calls this once per robot.
+        """
+        odom = joints = b""
+        if odometry:
+            x, y, yaw, forward, turn = self.robot.odometry_values()
+            half = yaw / 2  # quaternion(0, 0, yaw)
+            qz, qw = math.sin(half), math.cos(half)
+            tf += (sec, nanosec)  # (three extends: no tuple built around the frames)
+            tf += self._frames
+            tf += (x, y, 0.0, 0.0, 0.0, qz, qw)
+            if odometry == MESSAGE:
+                buffer = self._odometry_buffer
+                pose, twist = self._odometry_offsets
+                _STAMP_INTO(buffer, 4, sec, nanosec)  # after the encapsulation header
+                _POSE_INTO(buffer, pose, x, y, qz, qw)
+                _TWIST_INTO(buffer, twist, forward, turn)
+                odom = bytes(buffer)
+        if wheels:
+            robot = self.robot
+            angles = robot.wheels
+            for head, (ax, ay, az, aw), joint in self._wheel_heads:
+                # multiply(rotation, a turn about z), written out: the same operations in the
+                # same order as wheel_transforms', so the same numbers
+                if joint is not None and (spin := angles[joint]):
+                    bz, bw = math.sin(spin / 2), math.cos(spin / 2)
+                    tf += (
+                        sec, nanosec, *head,
+                        aw * 0.0 + ax * bw + ay * bz - az * 0.0,
+                        aw * 0.0 - ax * bz + ay * bw + az * 0.0,
+                        aw * bz + ax * 0.0 - ay * 0.0 + az * bw,
+                        aw * bw - ax * 0.0 - ay * 0.0 - az * bz,
+                    )  # fmt: skip
+                else:
+                    tf += (sec, nanosec, *head, ax, ay, az, aw)
+            if wheels == MESSAGE:
+                buffer = self._joint_buffer
+                _STAMP_INTO(buffer, 4, sec, nanosec)
+                values_into = self._joint_values_into  # (None: no joint the robot turns)
+                if values_into is not None and self._whole:
+                    values_into(buffer, self._joint_offset, *angles, self._values,
+                                *robot.wheel_rates)  # fmt: skip
+                elif values_into is not None:
+                    count = self._values
+                    values_into(buffer, self._joint_offset, *angles[:count], count,
+                                *robot.wheel_rates[:count])  # fmt: skip
+                joints = bytes(buffer)
+        return odom, joints
 
     def odom_transform(self, odom: tuple[tuple[float, float, float], object]) -> Transform:
         """``odom -> base_footprint`` of ``odom`` (the robot's :meth:`odometry`)."""
@@ -411,19 +475,7 @@ class RobotEncoder:
         The same numbers as :meth:`wheel_transforms` (its quaternion product, written out
         for a turn about z, with the same operations in the same order).
         """
-        angles = self.sim_robot.robot.wheels
-        for head, (ax, ay, az, aw), joint in self._wheel_heads:
-            if joint is not None and (spin := angles[joint]):
-                bz, bw = math.sin(spin / 2), math.cos(spin / 2)
-                tf += (
-                    sec, nanosec, *head,
-                    aw * 0.0 + ax * bw + ay * bz - az * 0.0,
-                    aw * 0.0 - ax * bz + ay * bw + az * 0.0,
-                    aw * bz + ax * 0.0 - ay * 0.0 + az * bw,
-                    aw * bw - ax * 0.0 - ay * 0.0 - az * bz,
-                )  # fmt: skip
-            else:
-                tf += (sec, nanosec, *head, ax, ay, az, aw)
+        self.tick_at(sec, nanosec, tf, NOT_DUE, TRANSFORM)
 
     def joint_states(self, now_ns: int) -> bytes:
         """sensor_msgs/JointState of the wheels as CDR."""
@@ -431,18 +483,16 @@ class RobotEncoder:
 
     def joint_states_at(self, sec: int, nanosec: int) -> bytes:
         """sensor_msgs/JointState of the wheels as CDR, stamped ``sec``, ``nanosec``."""
-        robot = self.sim_robot.robot
-        count = len(self.joint_names)
-        position, velocity = robot.wheels[:count], robot.wheel_rates[:count]
-        return self._joints(
-            encode.HEADER, sec, nanosec, 1, b"", count, *self._names,
-            len(position), *position, len(velocity), *velocity, 0,
-        )  # fmt: skip
+        return self.tick_at(sec, nanosec, [], NOT_DUE, MESSAGE)[1]
 
     def laser_scan(self, lidar: Lidar, ranges: np.ndarray, now_ns: int) -> bytes:
         """sensor_msgs/LaserScan of one of the robot's LiDARs as CDR."""
         frame, fields = self.scans[lidar]
         return encode.laser_scan(now_ns, frame, fields, ranges)
+
+    def scan_packer(self, lidar: Lidar) -> encode.ScanPacker:
+        """The packer of one of the robot's LiDARs' scans: (sec, nanosec, ranges) -> CDR."""
+        return encode.ScanPacker(*self.scans[lidar])
 
 
 def odometry_bytes(sim_robot: SimRobot, now_ns: int) -> bytes:

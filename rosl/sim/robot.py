@@ -76,6 +76,8 @@ class DiffDriveRobot:
         self._turn = 0.0
         self._dt = 0.0
         self._dv = self._dw = self._push = self._twist = 0.0
+        x0, y0, yaw0 = spec.pose  # the odom frame: the spawn pose, and the turn back from it
+        self._origin = (x0, y0, yaw0, math.cos(-yaw0), math.sin(-yaw0))
 
     def command(self, linear: float, angular: float) -> str | None:
         """Set the velocity command; return a warning text when it had to be clamped or dropped."""
@@ -181,10 +183,14 @@ class DiffDriveRobot:
 
     def odometry(self) -> tuple[tuple[float, float, float], tuple[float, float]]:
         """((x, y, yaw) in the odom frame, (forward speed, yaw rate))."""
-        x0, y0, yaw0 = self.spec.pose
+        x, y, yaw, forward, turn = self.odometry_values()
+        return (x, y, yaw), (forward, turn)
+
+    def odometry_values(self) -> tuple[float, float, float, float, float]:
+        """:meth:`odometry` flat: x, y, yaw in the odom frame, forward speed, yaw rate."""
+        x0, y0, yaw0, c, s = self._origin
         x, y, yaw = self._x, self._y, self._angle
-        c, s = math.cos(-yaw0), math.sin(-yaw0)
         dx, dy = x - x0, y - y0
         vx, vy = self._velocity
         forward = vx * math.cos(yaw) + vy * math.sin(yaw)
-        return (c * dx - s * dy, s * dx + c * dy, yaw - yaw0), (forward, self._turn)
+        return c * dx - s * dy, s * dx + c * dy, yaw - yaw0, forward, self._turn

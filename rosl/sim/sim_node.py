@@ -16,17 +16,21 @@ messages go out before ``/clock``, so a timer woken by the new time sees the ste
 With ``record``, an in-process recorder writes the bus to MCAP with sim-time log times.
 
 Paced (and not recording), the high-rate topics coalesce (``rosl/bus/coalesce.py``): a step's
-messages wait in their topic's list, which this thread publishes as one batch once a
-millisecond of wall time and before it sleeps (sensors first, ``/clock`` last; no timer thread
-contends for the GIL), and the bus is served at that pace rather than every step: a datagram,
-or even a publish call, per step per topic would cost more than the physics. Lock-step and
-recording keep one datagram per message and serve the bus every step.
+messages wait in their topic's list, which this thread publishes as one batch before it sleeps
+(sensors first, ``/clock`` last; no timer thread contends for the GIL) and, when it never
+sleeps (running flat out, above what the pace asks), every eight milliseconds of wall time; the
+bus is looked at (cmd_vel, parameters) before each wait and, flat out, every two milliseconds,
+rather than every step: a datagram, or even a publish call, per step per topic would cost more
+than the physics, and each flush (framing, MACs, a send per batch) and each look at the bus
+has a fixed cost of tens of microseconds, which a longer interval spreads over more steps.
+Lock-step and recording keep one datagram per message and serve the bus every step.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+import operator
 import sys
 import time
 from dataclasses import dataclass, field
@@ -35,6 +39,7 @@ from typing import TYPE_CHECKING, Any
 from rosl.graph.records import SUBSCRIPTION
 from rosl.sim import encode
 from rosl.sim import messages as build
+from rosl.sim.messages import MESSAGE, NOT_DUE, TRANSFORM
 from rosl.sim.report import RobotReport, SimReport
 from rosl.sim.simulation import Schedule
 
@@ -46,15 +51,18 @@ if TYPE_CHECKING:
     from rosl.node.lockstep import LockstepSource
     from rosl.node.node import Node
     from rosl.node.publisher import Publisher
+    from rosl.sim.encode import ScanPacker
     from rosl.sim.options import SimOptions
     from rosl.sim.simulation import SimRobot, Simulation
     from rosl.sim.worldfile import Lidar
 
 NS = 1_000_000_000
-SERVE_EVERY_S = 0.001  # paced: wall seconds between looks at the bus (cmd_vel, parameters)
-# paced: a topic's batch bound, so a millisecond's messages (~24 odometries of 720 bytes at
-# 800x real time) go as one datagram, built in one join (the bus caps it at a datagram's size)
-HELD_BYTES = 60000
+SERVE_EVERY_S = 0.002  # paced, flat out: wall seconds between looks at the bus (cmd_vel, ...)
+FLUSH_EVERY_S = 0.008  # paced, flat out: wall seconds between sends of the batches
+# paced: a topic's batch bound, a datagram's size (the bus caps it there): 8 ms of odometry at
+# 700x real time (~170 of 736 bytes) go in three
+HELD_BYTES = 65000
+_DUE = operator.attrgetter("at_ns")  # a schedule's next due time
 
 
 class _Topic:
@@ -65,6 +73,7 @@ class _Topic:
         self.publisher = publisher
         self.always = always or sim_node._publish_all
         self._publish = publisher.publish
+        self._publish_all = publisher.publish_all
         self._pending: list[bytes] = []
 
     def wanted(self) -> bool:
@@ -89,7 +98,7 @@ class _Topic:
         """Publish what waits as the publisher's batch, and send it (its only messages)."""
         pending = self._pending
         if pending:
-            self.publisher.publish_all(pending, flush=True)
+            self._publish_all(pending, flush=True)
             pending.clear()
 
 
@@ -101,9 +110,13 @@ class _RobotTopics:
     scans: list[_Topic]
     description: Publisher
     encoder: build.RobotEncoder
-    lidars: list[tuple[Lidar, Schedule, _Topic]] = field(default_factory=list)
+    # each LiDAR with its schedule, topic and packer (see RobotEncoder.scan_packer)
+    lidars: list[tuple[Lidar, Schedule, _Topic, ScanPacker]] = field(default_factory=list)
     odom_key: int = 0  # this robot's odometry transform in a tick's /tf (see SimNode._tf_pack)
     wheel_key: int = 0  # and its wheels'
+    # the joint states at the odometry's rate: both schedules fall due at the same ticks and
+    # fire alike from the same start, so the joints' takes the odometry's firing
+    twin: bool = False
 
 
 class SimNode:
@@ -209,11 +222,18 @@ class SimNode:
                 sim_robot, odom, joints, scans, description, build.RobotEncoder(sim_robot)
             )
             topics.lidars = [
-                (lidar, s, t) for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
+                (lidar, s, t, topics.encoder.scan_packer(lidar))
+                for (lidar, s), t in zip(sim_robot.lidars, scans, strict=True)
             ]
             topics.odom_key, topics.wheel_key = 2 * len(self.robots), 2 * len(self.robots) + 1
+            joints_schedule = sim_robot.joints
+            topics.twin = joints_schedule is not None and (
+                (joints_schedule.rate, joints_schedule.index)
+                == (sim_robot.odom.rate, sim_robot.odom.index)
+            )
             self.robots.append(topics)
         self._tf_packs: dict[tuple[int, ...], Callable[..., bytes]] = {}
+        self._clock_pack = functools.partial(encode.CLOCK.pack, encode.HEADER)  # (sec, nanosec)
 
     # --- bus helpers -------------------------------------------------------------------------
 
@@ -275,39 +295,46 @@ class SimNode:
             sim_robot = topics.sim_robot
             encoder = topics.encoder
             odom = sim_robot.odom
+            odometry = wheels = NOT_DUE
             if now >= odom.at_ns:
                 odom.fire(now)
                 if not sampled:
                     sim.sample()
                     sampled = True
                 topic = topics.odom
-                wanted = topic.always or topic.wanted()
-                message = encoder.odometry_at(sec, nanosec, values, wanted)
-                if wanted:
-                    topic.send(message)
+                odometry = MESSAGE if topic.always or topic.wanted() else TRANSFORM
                 key += (topics.odom_key,)
             joints = sim_robot.joints
+            states_topic = topics.joints
             if joints is not None and now >= joints.at_ns:
-                joints.fire(now)
-                topic_or_none = topics.joints
-                if topic_or_none is not None and (topic_or_none.always or topic_or_none.wanted()):
-                    topic_or_none.send(encoder.joint_states_at(sec, nanosec))
-                encoder.wheels_at(sec, nanosec, values)
+                if topics.twin:  # the odometry's firing, just taken: the same numbers
+                    joints.index, joints.at_ns = odom.index, odom.at_ns
+                else:
+                    joints.fire(now)
+                wheels = TRANSFORM
+                if states_topic is not None and (states_topic.always or states_topic.wanted()):
+                    wheels = MESSAGE
                 key += (topics.wheel_key,)
-            for lidar, schedule, topic in topics.lidars:
+            if odometry or wheels:  # one call for both (their messages, b"" where none)
+                message, states = encoder.tick_at(sec, nanosec, values, odometry, wheels)
+                if odometry == MESSAGE:
+                    topics.odom.send(message)
+                if states_topic is not None and wheels == MESSAGE:
+                    states_topic.send(states)
+            for lidar, schedule, topic, scan_bytes in topics.lidars:
                 if now >= schedule.at_ns:
                     index = schedule.fire(now)
                     wanted = topic.always or topic.wanted()
                     if wanted or self.options.render is not None:
                         ranges = sim.scan(sim_robot, lidar, index)
                         if wanted:
-                            topic.send(encoder.laser_scan(lidar, ranges, now))
+                            topic.send(scan_bytes(sec, nanosec, ranges))
         tf = self.tf
         if key and (tf.always or tf.wanted()):  # one /tf message per tick, as a broadcaster
             pack = self._tf_packs.get(key) or self._tf_pack(key)
             tf.send(pack(*values))
-        self.clock.send(encode.CLOCK.pack(encode.HEADER, sec, nanosec))  # every step's data too
-        self._next_event = min([schedule.at_ns for schedule in self._schedules])
+        self.clock.send(self._clock_pack(sec, nanosec))  # every step's data too
+        self._next_event = min(map(_DUE, self._schedules))
 
     def _tf_pack(self, key: tuple[int, ...]) -> Callable[..., bytes]:
         """The packer of /tf of these robots' odometry (2 k) and wheels (2 k + 1) transforms.
@@ -382,17 +409,26 @@ class SimNode:
         return self._finish(wall)
 
     def _run_paced(self, started: float, end_ns: int | None, live: bool) -> None:
-        """The paced loop: the bus, Ctrl-C and the status line looked at once a millisecond."""
+        """The paced loop: the bus, its batches, Ctrl-C and the status line.
+
+        When the loop never waits (flat out), the bus is looked at every
+        :data:`SERVE_EVERY_S` and the batches go out every :data:`FLUSH_EVERY_S`; when it
+        waits, both happen before each wait, and the bus is served throughout (see
+        :meth:`_pace`).
+        """
         sim, tick, step, step_ns = self.sim, self.tick, self.sim.step, self.sim.step_ns
+        advance = sim.advance
         context, monotonic = self.node.context, time.monotonic
         scale = NS * self.options.real_time_factor  # sim ns per wall second
         end = math.inf if end_ns is None else end_ns
         status_at = started + 1.0
-        serve_at = 0.0
+        serve_at = flush_at = 0.0
         while True:
             wall = monotonic()
             if wall >= serve_at:
-                self._flush()
+                if wall >= flush_at:
+                    self._flush()
+                    flush_at = wall + FLUSH_EVERY_S
                 if not context.ok():
                     return
                 self.executor.spin_some()  # /cmd_vel, parameters
@@ -408,10 +444,7 @@ class SimNode:
                 self._pace(started)
                 step()
             else:  # the steps that publish nothing run back to back, the clock unread
-                stop = min(self._next_event, end)
-                step()
-                while sim.now_ns < stop and sim.now_ns <= allowed:
-                    step()
+                advance(min(self._next_event, end), allowed)
             if sim.now_ns >= self._next_event:
                 tick()
 

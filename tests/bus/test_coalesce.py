@@ -166,6 +166,35 @@ def test_send_all_numbers_batches_and_bounds_like_one_send_each(domain_id: int) 
         counted.close()
 
 
+def test_send_all_of_more_than_a_batch_splits_where_one_send_each_would(domain_id: int) -> None:
+    # messages of mixed sizes, several batches' worth, after one that waits: send_all fills
+    # each batch as far as one send() each would, and a flush sends the rest at once
+    sizes = [900 + (n * 37) % 700 for n in range(60)]
+    splits = []
+    for one_by_one in (True, False):
+        counted = Counted(domain_id, delay_s=60.0)
+        try:
+            writer = counted.bus.writer
+            writer.send(payload_of(3000, seed=1))
+            payloads = [payload_of(size, seed=n) for n, size in enumerate(sizes)]
+            if one_by_one:
+                for payload in payloads:
+                    writer.send(payload)
+                writer.flush()
+            else:
+                writer.send_all(payloads, flush=True)
+            got = counted.bus.collector.wait_count(61, timeout=20.0)
+            assert [bytes(d.payload) for d in got] == [payload_of(3000, seed=1), *payloads]
+            assert [d.seq for d in got] == list(range(1, 62))
+            batches = batched_records(counted.datagrams())
+            assert all(sum(RECORD.size + len(r[2]) for r in b) <= LIMIT for b in batches)
+            splits.append([[r[0] for r in b] for b in batches])
+        finally:
+            counted.close()
+    assert splits[0] == splits[1]
+    assert len(splits[0]) >= 4
+
+
 def test_send_all_with_flush_sends_at_once_what_fits_in_one_datagram(domain_id: int) -> None:
     # the flusher would wait a minute: with flush=True the batch goes out in the same call
     counted = Counted(domain_id, delay_s=60.0)

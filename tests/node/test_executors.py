@@ -901,6 +901,50 @@ def test_a_fast_timer_between_its_ticks_lets_guards_waitables_and_messages_throu
     assert spin_until(executor, lambda: len(ticks) >= before + 20)  # it still ticks
 
 
+def spin_some_until(executor: Executor, predicate: Callable[[], bool]) -> bool:
+    """Call ``spin_some()`` (no wait) until ``predicate()`` or the (bounded) deadline."""
+    deadline = time.monotonic() + BOUND
+    while not predicate():
+        if time.monotonic() >= deadline:
+            return predicate()
+        executor.spin_some()
+        time.sleep(0.001)
+    return True
+
+
+def test_spin_some_after_looks_that_found_nothing_still_runs_whatever_comes(ros):
+    # a spin_some that found nothing is remembered: until something announces a change, the
+    # next ones look only at the transport and the timers (the simulator calls it once a
+    # millisecond); messages, a guard, a task and a timer that falls due must all still run
+    from rosl.idl.registry import get_message_class
+
+    node, executor = settled(ros, "quiet_looker")
+    String = get_message_class("std_msgs/msg/String")
+    heard: list[str] = []
+    node.create_subscription(String, "/after_quiet", lambda m: heard.append(m.data), 100)
+    talker = ros.Node("quiet_talker").create_publisher(String, "/after_quiet", 100)
+    guarded: list[int] = []
+    guard = node.create_guard_condition(lambda: guarded.append(1))
+    for _ in range(5):  # looks that find nothing (unless this machine took a second for them)
+        executor.spin_some()
+    for i in range(5):
+        threading.Thread(target=talker.publish, args=(String(data=f"m{i}"),)).start()
+        assert spin_some_until(executor, lambda i=i: len(heard) > i), heard
+        executor.spin_some()
+    assert heard == [f"m{i}" for i in range(5)]
+    threading.Thread(target=guard.trigger, daemon=True).start()
+    assert spin_some_until(executor, lambda: bool(guarded))
+    done: list[int] = []
+    executor.spin_some()
+    executor.create_task(lambda: done.append(1))
+    assert spin_some_until(executor, lambda: bool(done))
+    ticks: list[int] = []
+    node.create_timer(1.0, lambda: ticks.append(1))  # (no timer before: none looks for them)
+    assert spin_some_until(executor, lambda: bool(ticks))  # due a second after it was made
+    assert guarded == [1]
+    assert done == [1]
+
+
 def test_a_guard_triggered_while_spin_once_waits_for_a_distant_timer_runs_first(ros):
     # the wait ends at the change, and the look after it is not the timers-only one
     node, executor = settled(ros, "distant_timer")

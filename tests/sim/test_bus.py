@@ -211,3 +211,52 @@ def test_clock_goes_out_at_its_rate_and_with_every_steps_data(
         assert 60 <= len(clock) < 120, clock
     else:  # at or above the 100 Hz physics: every step
         assert clock == list(range(0, 2 * 10**9 + 1, 10_000_000))
+
+
+def test_flat_out_the_batches_bring_every_message_of_every_firing(ros: Any) -> None:
+    # paced far above what the machine can do, the loop never waits: the topics go out in
+    # batches every few milliseconds of wall time (several datagrams when a batch is full);
+    # a subscriber still gets each firing's message once, in order, clock with all the data
+    from rosl.idl.registry import get_message_class
+    from rosl.node.qos import QoSProfile, ReliabilityPolicy
+    from rosl.sim.options import SimOptions
+    from rosl.sim.sim_node import SimNode
+    from rosl.sim.simulation import Schedule, Simulation
+    from rosl.sim.worldfile import load_world, resolve_world
+
+    inbox = Inbox(ros, ros.Node("listener"))
+    for topic in ("/clock", "/odom", "/joint_states", "/tf"):
+        inbox.listen(get_message_class(TOPICS[topic]), topic, 100_000)
+    best_effort = QoSProfile(depth=100_000, reliability=ReliabilityPolicy.BEST_EFFORT)
+    inbox.listen(get_message_class(TOPICS["/scan"]), "/scan", best_effort)  # as sensor data
+    sim = Simulation(load_world(resolve_world("turtlebot3_world")))
+    options = SimOptions(real_time_factor=1e9, duration=20.0, headless=True)
+    runner = SimNode(sim, ros.Node("sim"), options, publish_all=True)
+    runner.run()
+
+    def expected(rate: float) -> list[int]:  # the firings on the 10 ms steps up to 20 s
+        schedule, out = Schedule(rate), []
+        for now in range(0, 20 * 10**9 + 1, sim.step_ns):
+            if schedule.due(now):
+                schedule.fire(now)
+                out.append(now)
+        return out
+
+    odometry, scans = expected(30.0), expected(5.0)
+    assert inbox.spin_until(lambda: len(inbox.got.get("/clock", [])) >= len(odometry), 60.0)
+    assert inbox.spin_until(
+        lambda: all(len(inbox.got.get(t, [])) >= len(odometry) for t in ("/odom", "/tf")), 60.0
+    )
+    stamps = {
+        topic: [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in inbox.got[topic]]
+        for topic in ("/odom", "/joint_states", "/scan")
+    }
+    assert stamps["/odom"] == odometry
+    assert stamps["/joint_states"] == odometry
+    assert stamps["/scan"] == scans
+    tf = [m.transforms[0].header.stamp for m in inbox.got["/tf"]]
+    assert [s.sec * 10**9 + s.nanosec for s in tf] == odometry
+    clock = [m.clock.sec * 10**9 + m.clock.nanosec for m in inbox.got["/clock"]]
+    assert clock == sorted(set(clock))
+    assert set(odometry) <= set(clock)
+    assert clock == sorted(set(odometry) | set(expected(10.0)))

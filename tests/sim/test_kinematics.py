@@ -177,3 +177,24 @@ def test_odometry_is_relative_to_the_spawn_pose(write_world: Callable[..., Path]
     assert ox == pytest.approx(0.2 * 3 - 0.02, abs=2e-3)  # minus the 0.2 s ramp at 1 m/s^2
     assert oy == pytest.approx(0.0, abs=1e-9)  # the wheels' grip is solved in floating point
     assert oyaw == 0.0
+
+
+@pytest.mark.parametrize("world_name", ["turtlebot3_world", "dolly_field"])
+def test_advance_leaves_the_world_as_the_same_steps_one_by_one(world_name: str) -> None:
+    # the paced sim node's steps between publications: one step, then more while before the
+    # stop and not after the limit; bodies, clock, counts and distances as step() leaves them
+    one_by_one, advanced = (Simulation(load_world(resolve_world(world_name))) for _ in range(2))
+    for sim in (one_by_one, advanced):
+        sim.robots[0].robot.command(0.2, 0.9)
+    for stop, limit in [(35_000_000, math.inf), (10**9, 4.2e8), (0, math.inf), (10**12, 1.5e9)]:
+        one_by_one.step()
+        while one_by_one.now_ns < stop and one_by_one.now_ns <= limit:
+            one_by_one.step()
+        advanced.advance(stop, limit)
+        assert advanced.now_ns == one_by_one.now_ns
+        assert advanced.steps == one_by_one.steps
+        for a, b in zip(advanced.robots, one_by_one.robots, strict=True):
+            assert a.robot.pose == b.robot.pose
+            assert a.robot.wheels == b.robot.wheels
+            assert a.distance == b.distance
+    assert advanced.now_ns == 1_510_000_000  # the last limit, passed by one step
