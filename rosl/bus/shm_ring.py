@@ -20,8 +20,9 @@ waits for readers, so a subscriber that falls more than a ring behind loses the 
 messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
 writer within a sixteenth of the ring of reusing the slot it is about to copy does not copy
 (the copy would likely end torn, and at that distance its source has left the CPU's caches):
-it drops the messages up to that many slots behind the writer, counted the same way, and
-goes on with the newest. (The checks rely
+it drops the messages older than the newest megabyte or so (:data:`CACHED_BYTES`, at least
+one slot), counted the same way, and goes on with the newest, which its copies then find in
+the caches: a reader that stays a ring behind copies at a fraction of that speed. (The checks rely
 on stores becoming visible in program order, as on x86-64; the slot is only reused after a
 whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
 
@@ -69,6 +70,7 @@ DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
 POOLED = 8  # buffers kept per ring size beyond those one drain's copies take
 DRAIN_BYTES = 1024 * 1024  # copies one drain of a receiver makes at most (see wire.py)
+CACHED_BYTES = 1024 * 1024  # what a reader skipping ahead keeps of the newest messages
 _UNUSED = 3  # sys.getrefcount of a pooled buffer nobody holds: the pool, the loop, the call
 
 
@@ -199,8 +201,10 @@ class _Mapped:
             raise ValueError("not a ring")
         self.slots, self.capacity = slots, capacity
         self.data_at = data_at(slots)
-        # a reader this close to being lapped skips to this many slots behind the writer
+        # a reader this close to being lapped skips to ``keep`` slots behind the writer: the
+        # newest megabyte or so, which the CPU's caches may still hold
         self.margin = max(2, slots // 16)
+        self.keep = max(1, min(self.margin, CACHED_BYTES // capacity))
         self.skip_below = 0  # descriptors of older messages are dropped without a look
         self.view = memoryview(self.map)
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
@@ -305,7 +309,7 @@ class RingReader:
         # it drops what is older than the newest few slots and goes on from there
         ahead = number + ring.slots - ring.margin  # the writer has begun this message
         if generations[(number - ring.margin) % ring.slots] >= 2 * ahead - 1:
-            ring.skip_below = ahead - ring.margin
+            ring.skip_below = ahead - ring.keep
             self.overwritten += 1
             return None
         start = ring.data_at + slot * ring.capacity
