@@ -20,9 +20,11 @@ waits for readers, so a subscriber that falls more than a ring behind loses the 
 messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
 writer within a sixteenth of the ring of reusing the slot it is about to copy does not copy
 (the copy would likely end torn, and at that distance its source has left the CPU's caches):
-it drops the messages older than the newest megabyte or so (:data:`CACHED_BYTES`, at least
-one slot), counted the same way, and goes on with the newest, which its copies then find in
-the caches: a reader that stays a ring behind copies at a fraction of that speed. (The checks rely
+it drops that many messages, counted the same way, and goes on. If that happens again
+within a ring of messages (the reader stays behind, not a passing stall), it drops all but
+the newest megabyte or so (:data:`CACHED_BYTES`, at least one slot) and goes on with those,
+which its copies then find in the caches: a reader that stays a ring behind copies at a
+fraction of that speed. (The checks rely
 on stores becoming visible in program order, as on x86-64; the slot is only reused after a
 whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
 
@@ -201,11 +203,13 @@ class _Mapped:
             raise ValueError("not a ring")
         self.slots, self.capacity = slots, capacity
         self.data_at = data_at(slots)
-        # a reader this close to being lapped skips to ``keep`` slots behind the writer: the
-        # newest megabyte or so, which the CPU's caches may still hold
+        # a reader this close to being lapped drops ``margin`` messages; if it gets this close
+        # again within a ring, it skips to ``keep`` slots behind the writer: the newest
+        # megabyte or so, which the CPU's caches may still hold
         self.margin = max(2, slots // 16)
         self.keep = max(1, min(self.margin, CACHED_BYTES // capacity))
         self.skip_below = 0  # descriptors of older messages are dropped without a look
+        self.lapped_at = -slots  # the message at which the writer last nearly lapped us
         self.view = memoryview(self.map)
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
 
@@ -309,7 +313,11 @@ class RingReader:
         # it drops what is older than the newest few slots and goes on from there
         ahead = number + ring.slots - ring.margin  # the writer has begun this message
         if generations[(number - ring.margin) % ring.slots] >= 2 * ahead - 1:
-            ring.skip_below = ahead - ring.keep
+            if number - ring.lapped_at < ring.slots:  # again within a ring: it stays behind
+                ring.skip_below = ahead - ring.keep
+            else:  # a passing stall: a few messages make room
+                ring.skip_below = number + ring.margin
+            ring.lapped_at = number
             self.overwritten += 1
             return None
         start = ring.data_at + slot * ring.capacity
