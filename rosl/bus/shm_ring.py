@@ -18,15 +18,15 @@ checks it again; any other value means the slot was (or is being) reused for a n
 the read is refused and counted (``overwritten``), never delivered torn. The writer never
 waits for readers, so a subscriber that falls more than a ring behind loses the oldest
 messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
-writer within a sixteenth of the ring of reusing the slot it is about to copy does not copy
-(the copy would likely end torn, and at that distance its source has left the CPU's caches):
-it drops that many messages, counted the same way, and goes on. If that happens again
-within a ring of messages (the reader stays behind, not a passing stall), it drops all but
-the newest megabyte or so (:data:`CACHED_BYTES`, at least one slot) and goes on with those,
-which its copies then find in the caches: a reader that stays a ring behind copies at a
-fraction of that speed. (The checks rely
-on stores becoming visible in program order, as on x86-64; the slot is only reused after a
-whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
+writer within a sixteenth of the ring (a slot at least) of reusing the slot it is about to
+copy does not copy (the copy would likely end torn, and at that distance its source has left
+the CPU's caches): it drops that many messages, counted the same way, and goes on. If that
+happens again within a ring of messages (the reader stays behind, not a passing stall), it
+drops all but the newest megabyte or so (:data:`CACHED_BYTES`, at least one slot) and goes on
+with those, which its copies then find in the caches: a reader that stays a ring behind
+copies at a fraction of that speed. (The checks rely on stores becoming visible in program
+order, as on x86-64; the slot is only reused after a whole ring of newer messages, which
+bounds the window on weaker CPUs to that lap.)
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
@@ -206,7 +206,7 @@ class _Mapped:
         # a reader this close to being lapped drops ``margin`` messages; if it gets this close
         # again within a ring, it skips to ``keep`` slots behind the writer: the newest
         # megabyte or so, which the CPU's caches may still hold
-        self.margin = max(2, slots // 16)
+        self.margin = max(1, slots // 16)
         self.keep = max(1, min(self.margin, CACHED_BYTES // capacity))
         self.skip_below = 0  # descriptors of older messages are dropped without a look
         self.lapped_at = -slots  # the message at which the writer last nearly lapped us
@@ -310,7 +310,7 @@ class RingReader:
         # the writer is (nearly) a ring ahead: it will reuse the slot while we copy. A copy
         # that ends torn costs as much as one that delivers, and a reader that stays a ring
         # behind copies from memory the writer left long ago (out of the CPU's caches); so
-        # it drops what is older than the newest few slots and goes on from there
+        # it drops a few messages, or all but the newest if it was this close before
         ahead = number + ring.slots - ring.margin  # the writer has begun this message
         if generations[(number - ring.margin) % ring.slots] >= 2 * ahead - 1:
             if number - ring.lapped_at < ring.slots:  # again within a ring: it stays behind
