@@ -20,8 +20,9 @@ them only when they are regular files of their own user that nobody else can rea
 
 Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
 transport closes (and at interpreter exit); one replaced by a bigger ring, or whose publisher
-was destroyed, :data:`RETIRE_S` seconds later (descriptors of its last messages may still
-wait in a subscriber's socket, and the subscriber may not have mapped it yet). A crashed
+was destroyed, at the first message the transport writes :data:`RETIRE_S` seconds later or
+more (descriptors of its last messages may still wait in a subscriber's socket, and the
+subscriber may not have mapped it yet). A crashed
 process leaves its rings behind until the next sweep (:func:`sweep`): when any process of the
 user opens shared memory, then at most every :data:`SWEEP_S` seconds while it writes or maps
 rings, every ring whose owner (pid, process start time, pid namespace) is no longer running
