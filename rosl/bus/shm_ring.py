@@ -20,13 +20,11 @@ waits for readers, so a subscriber that falls more than a ring behind loses the 
 messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
 writer within a sixteenth of the ring (a slot at least) of reusing the slot it is about to
 copy does not copy (the copy would likely end torn, and at that distance its source has left
-the CPU's caches): it drops that many messages, counted the same way, and goes on. If that
-happens again within a ring of messages (the reader stays behind, not a passing stall), it
-drops all but the newest megabyte or so (:data:`CACHED_BYTES`, at least one slot) and goes on
-with those, which its copies then find in the caches: a reader that stays a ring behind
-copies at a fraction of that speed. (The checks rely on stores becoming visible in program
-order, as on x86-64; the slot is only reused after a whole ring of newer messages, which
-bounds the window on weaker CPUs to that lap.)
+the CPU's caches): it drops that many messages, counted the same way, and goes on with the
+next; skipping further, to the newest messages, measured no faster for a reader that stays
+behind, and lost more to a passing stall. The checks rely on stores becoming visible in
+program order, as on x86-64; the slot is only reused after a whole ring of newer messages,
+which bounds the window on weaker CPUs to that lap.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
@@ -72,7 +70,6 @@ DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
 POOLED = 8  # buffers kept per ring size beyond those one drain's copies take
 DRAIN_BYTES = 1024 * 1024  # copies one drain of a receiver makes at most (see wire.py)
-CACHED_BYTES = 1024 * 1024  # what a reader skipping ahead keeps of the newest messages
 _UNUSED = 3  # sys.getrefcount of a pooled buffer nobody holds: the pool, the loop, the call
 
 
@@ -203,13 +200,8 @@ class _Mapped:
             raise ValueError("not a ring")
         self.slots, self.capacity = slots, capacity
         self.data_at = data_at(slots)
-        # a reader this close to being lapped drops ``margin`` messages; if it gets this close
-        # again within a ring, it skips to ``keep`` slots behind the writer: the newest
-        # megabyte or so, which the CPU's caches may still hold
-        self.margin = max(1, slots // 16)
-        self.keep = max(1, min(self.margin, CACHED_BYTES // capacity))
+        self.margin = max(1, slots // 16)  # a reader this close to being lapped drops as many
         self.skip_below = 0  # descriptors of older messages are dropped without a look
-        self.lapped_at = -slots  # the message at which the writer last nearly lapped us
         self.view = memoryview(self.map)
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
 
@@ -308,16 +300,11 @@ class RingReader:
             self.overwritten += 1
             return None
         # the writer is (nearly) a ring ahead: it will reuse the slot while we copy. A copy
-        # that ends torn costs as much as one that delivers, and a reader that stays a ring
-        # behind copies from memory the writer left long ago (out of the CPU's caches); so
-        # it drops a few messages, or all but the newest if it was this close before
+        # that ends torn costs as much as one that delivers (a reader a ring behind would
+        # spend all its time on such copies), so it drops a few messages to make room
         ahead = number + ring.slots - ring.margin  # the writer has begun this message
         if generations[(number - ring.margin) % ring.slots] >= 2 * ahead - 1:
-            if number - ring.lapped_at < ring.slots:  # again within a ring: it stays behind
-                ring.skip_below = ahead - ring.keep
-            else:  # a passing stall: a few messages make room
-                ring.skip_below = number + ring.margin
-            ring.lapped_at = number
+            ring.skip_below = number + ring.margin
             self.overwritten += 1
             return None
         start = ring.data_at + slot * ring.capacity
