@@ -1,6 +1,6 @@
 """Shared memory for large messages between processes of one host: when, where, and cleanup.
 
-Above :func:`threshold` bytes (64 KiB; ``ROSL_SHM_THRESHOLD`` changes it) a publisher whose
+Above :func:`threshold` bytes (16 KiB; ``ROSL_SHM_THRESHOLD`` changes it) a publisher whose
 matched subscribers all announced this process's :func:`host_identity` writes the message
 into its ring (:mod:`rosl.bus.shm_ring`) and sends only a small descriptor datagram, signed
 like every other (the hardened bus's key covers it). Everything else — small messages,
@@ -19,10 +19,14 @@ mode 0600, created with ``O_EXCL|O_NOFOLLOW`` and memory reserved up front; read
 them only when they are regular files of their own user that nobody else can read.
 
 Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
-transport closes (and at interpreter exit). A crashed process leaves its rings behind until
-the next sweep (:func:`sweep`): when any process of the user opens shared memory, then at
-most every :data:`SWEEP_S` seconds while it writes or maps rings, every ring whose owner
-(pid, process start time, pid namespace) is no longer running is unlinked. Subscribers that
+transport closes (and at interpreter exit); one replaced by a bigger ring, or whose publisher
+was destroyed, at the first message the transport writes :data:`RETIRE_S` seconds later or
+more (descriptors of its last messages may still wait in a subscriber's socket, and the
+subscriber may not have mapped it yet). A crashed
+process leaves its rings behind until the next sweep (:func:`sweep`): when any process of the
+user opens shared memory, then at most every :data:`SWEEP_S` seconds while it writes or maps
+rings, every ring whose owner (pid, process start time, pid namespace) is no longer running
+is unlinked. Subscribers that
 mapped it keep reading what they have (an unlinked file stays mapped).
 """
 
@@ -48,11 +52,17 @@ if TYPE_CHECKING:
     from rosl.bus.transport import Buffer
 
 DIRECTORY = "/dev/shm"
-THRESHOLD = 64 * 1024  # bytes; larger messages take the ring
+# bytes; larger messages take the ring. Measured (bench/bus_throughput.py, 2 cores): from 16 KB
+# up, a message costs each side half the CPU it costs over the signed wire (no MAC over the
+# payload, no 64 KB datagram to copy through the kernel), and a ring's 1024 slots are 4-16
+# times the messages of 16-64 KB a 4 MiB socket buffer holds
+THRESHOLD = 16 * 1024
 RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring aims for
-MIN_SLOTS, MAX_SLOTS = 4, 128  # slack: 64 MiB of 1 MiB messages is 30 ms at 2 GB/s
-MIN_CAPACITY = 128 * 1024
+# slack: 64 MiB of 1 MiB messages is 30 ms at 2 GB/s; 1024 of 60 KB, 60 ms at 1 GB/s
+MIN_SLOTS, MAX_SLOTS = 4, 1024
+MIN_CAPACITY = 4096
 SWEEP_S = 30.0
+RETIRE_S = 5.0  # a ring replaced by a bigger one (or of a closed publisher) is unlinked this late
 STALE_PARTIAL_S = 60.0  # a file with no readable header this old is a half-made ring
 _NAME = re.compile(r"^rosl-u(\d+)-d(\d+)-p(\d+)-[0-9a-f]{16}-e\d+-r\d+$")
 _OFF = ("0", "off", "false", "no")
@@ -192,11 +202,17 @@ class SharedMemory:
         self.uid = os.geteuid()
         self._owner = this_process()
         self._rings: dict[tuple[int, int], RingWriter] = {}
+        # rings no longer written, kept until a deadline for readers that have not mapped
+        # them yet (descriptors of their last messages may still wait in a socket)
+        self._retired: list[tuple[float, RingWriter]] = []
         self._lock = threading.Lock()
         self._failed = False
         self._next_sweep = time.monotonic() + SWEEP_S
+        self._next_due = self._next_sweep  # the next sweep or retirement, whichever is first
         self.swept = sweep(directory, self.uid)  # at start: what crashed processes left
-        self._finalizer = weakref.finalize(self, _close_rings, self._rings, os.getpid())
+        self._finalizer = weakref.finalize(
+            self, _close_rings, self._rings, self._retired, os.getpid()
+        )
 
     def path(self, sender: int, endpoint: int, pid: int, incarnation: int) -> str:
         """Where the ring of one endpoint (of one process start) is."""
@@ -206,13 +222,15 @@ class SharedMemory:
     def put(self, sender: int, endpoint: int, payload: Buffer) -> bytes | None:
         """Write a message into the endpoint's ring; its descriptor, or None (send the bytes).
 
-        The ring is made on first use and made anew, bigger, when a message outgrows it.
+        The ring is made on first use and made anew, bigger, when a message outgrows it (the
+        old one is unlinked :data:`RETIRE_S` later: a subscriber may not have mapped it yet).
         """
         if self._failed:
             return None
         size = len(payload)
         with self._lock:
-            self._maybe_sweep()
+            if time.monotonic() >= self._next_due:
+                self._due()
             ring = self._rings.get((sender, endpoint))
             if ring is None or size > ring.capacity:
                 ring = self._grow(sender, endpoint, ring, size)
@@ -227,7 +245,7 @@ class SharedMemory:
         slots = max(MIN_SLOTS, min(MAX_SLOTS, RING_BYTES // capacity))
         incarnation = 1 if old is None else old.incarnation + 1
         if old is not None:
-            old.close()
+            self._retire(old)
         path = self.path(sender, endpoint, self._owner.pid, incarnation)
         try:
             ring = self._make(path, incarnation, slots, capacity)
@@ -254,11 +272,16 @@ class SharedMemory:
                 slots //= 2
 
     def drop(self, sender: int, endpoint: int) -> None:
-        """An endpoint is gone: unlink its ring."""
+        """An endpoint is gone: unlink its ring (:data:`RETIRE_S` later)."""
         with self._lock:
             ring = self._rings.pop((sender, endpoint), None)
-        if ring is not None:
-            ring.close()
+            if ring is not None:
+                self._retire(ring)
+
+    def _retire(self, ring: RingWriter) -> None:
+        deadline = time.monotonic() + RETIRE_S
+        self._retired.append((deadline, ring))
+        self._next_due = min(self._next_due, deadline)
 
     def reader(self) -> RingReader:
         """A reader for one receiver (maps rings of this user and domain on first use)."""
@@ -266,13 +289,23 @@ class SharedMemory:
 
     def _sweep_soon(self) -> None:
         with self._lock:
-            self._maybe_sweep()
+            if time.monotonic() >= self._next_due:
+                self._due()
 
-    def _maybe_sweep(self) -> None:
+    def _due(self) -> None:
+        """Sweep when due, and unlink retired rings whose time is up (under the lock)."""
         now = time.monotonic()
         if now >= self._next_sweep:
             self._next_sweep = now + SWEEP_S
             sweep(self.directory, self.uid)
+        kept = []
+        for deadline, ring in self._retired:
+            if deadline <= now:
+                ring.close()
+            else:
+                kept.append((deadline, ring))
+        self._retired[:] = kept
+        self._next_due = min([self._next_sweep, *(deadline for deadline, _ in kept)])
 
     def close(self) -> None:
         """Unlink every ring this transport made (idempotent)."""
@@ -280,10 +313,13 @@ class SharedMemory:
             self._finalizer()
 
 
-def _close_rings(rings: dict[tuple[int, int], RingWriter], owner: int) -> None:
+def _close_rings(
+    rings: dict[tuple[int, int], RingWriter], retired: list[tuple[float, RingWriter]], owner: int
+) -> None:
     # a child forked from the owner (os.fork, multiprocessing) unmaps but must not unlink
     # the rings its parent still writes
     unlink = os.getpid() == owner
-    for ring in list(rings.values()):
+    for ring in [*rings.values(), *(ring for _, ring in retired)]:
         ring.close(unlink)
     rings.clear()
+    retired.clear()

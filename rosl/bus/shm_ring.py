@@ -5,9 +5,11 @@ A large message is written into a slot of its publisher's ring (a file in ``/dev
 length) in a normal signed datagram. Subscribers of this host map the ring read-only and copy
 the message out. Policy (when to use a ring, names, cleanup) lives in :mod:`rosl.bus.shm`.
 
-Layout: page 0 holds the :data:`HEADER` (magic, slots, slot capacity, owner pid, the owner's
-process start time and pid namespace, which the cleanup pass checks) and from byte 64 one
-8-byte *generation* per slot; slot ``i``'s bytes start at page 1 + ``i * capacity``.
+Layout: the file starts with the :data:`HEADER` (magic, slots, slot capacity, owner pid, the
+owner's process start time and pid namespace, which the cleanup pass checks) and from byte 64
+one 8-byte *generation* per slot, in as many pages as they take (:func:`data_at`: one page up
+to 504 slots); slot ``i``'s bytes start after those pages, at ``data_at(slots) + i *
+capacity``.
 
 Safety against a slow subscriber (a seqlock per slot): the writer of message ``n`` sets the
 slot's generation to ``2n - 1`` (odd: being written), copies the payload, then sets it to
@@ -15,9 +17,14 @@ slot's generation to ``2n - 1`` (odd: being written), copies the payload, then s
 checks it again; any other value means the slot was (or is being) reused for a newer message:
 the read is refused and counted (``overwritten``), never delivered torn. The writer never
 waits for readers, so a subscriber that falls more than a ring behind loses the oldest
-messages, counted as loss, exactly as a full socket buffer would drop them. (The checks rely
-on stores becoming visible in program order, as on x86-64; the slot is only reused after a
-whole ring of newer messages, which bounds the window on weaker CPUs to that lap.)
+messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
+writer within a sixteenth of the ring (a slot at least) of reusing the slot it is about to
+copy does not copy (the copy would likely end torn, and at that distance its source has left
+the CPU's caches): it drops that many messages, counted the same way, and goes on with the
+next; skipping further, to the newest messages, measured no faster for a reader that stays
+behind, and lost more to a passing stall. The checks rely on stores becoming visible in
+program order, as on x86-64; the slot is only reused after a whole ring of newer messages,
+which bounds the window on weaker CPUs to that lap.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
@@ -43,7 +50,7 @@ import stat
 import struct
 import sys
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -54,15 +61,15 @@ if TYPE_CHECKING:
     # (sender, endpoint, pid, incarnation) -> the ring's path (see shm.py)
     Namer = Callable[[int, int, int, int], str]
 
-MAGIC = b"RLSHM\x00\x01\x00"
+MAGIC = b"RLSHM\x00\x02\x00"  # layout 2: the generations take as many pages as they need
 HEADER = struct.Struct("<8sIIIIQQ")  # magic, slots, capacity, pid, -, start time, pid ns
 GENERATIONS_AT = 64
 PAGE = mmap.PAGESIZE
-DATA_AT = PAGE
-MAX_SLOTS = (DATA_AT - GENERATIONS_AT) // 8
+MAX_SLOTS = 4096  # slots one ring may have (its generations then take 9 pages)
 DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
-POOLED = 8  # buffers kept per ring size for the copies out of slots
+POOLED = 8  # buffers kept per ring size beyond those one drain's copies take
+DRAIN_BYTES = 1024 * 1024  # copies one drain of a receiver makes at most (see wire.py)
 _UNUSED = 3  # sys.getrefcount of a pooled buffer nobody holds: the pool, the loop, the call
 
 
@@ -70,9 +77,14 @@ def _round_up(value: int, step: int) -> int:
     return -(-value // step) * step
 
 
+def data_at(slots: int) -> int:
+    """Where slot 0 starts in a ring of ``slots`` slots: after the header and generations."""
+    return _round_up(GENERATIONS_AT + 8 * slots, PAGE)
+
+
 def segment_size(slots: int, capacity: int) -> int:
     """Bytes of a ring file of ``slots`` slots of ``capacity`` bytes."""
-    return DATA_AT + slots * capacity
+    return data_at(slots) + slots * capacity
 
 
 @dataclass(frozen=True, slots=True)
@@ -113,6 +125,7 @@ class RingWriter:
         self.incarnation = incarnation
         self.slots = max(1, min(slots, MAX_SLOTS))
         self.capacity = _round_up(capacity, PAGE)
+        self._data_at = data_at(self.slots)
         self._pid = owner.pid
         size = segment_size(self.slots, self.capacity)
         flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
@@ -144,7 +157,7 @@ class RingWriter:
         number = self._next
         self._next += 1
         slot = number % self.slots
-        start = DATA_AT + slot * self.capacity
+        start = self._data_at + slot * self.capacity
         generations = self._generations
         generations[slot] = 2 * number - 1  # odd: being written
         self._view[start : start + size] = payload
@@ -173,7 +186,7 @@ class _Mapped:
             raise PermissionError("not a regular file of this user")
         if info.st_mode & 0o077:
             raise PermissionError("readable by other users")
-        if info.st_size < DATA_AT:
+        if info.st_size < PAGE:
             raise ValueError("too small for a ring")
         self.map = mmap.mmap(fd, info.st_size, mmap.MAP_SHARED, mmap.PROT_READ)
         magic, slots, capacity, *_ = HEADER.unpack_from(self.map)
@@ -186,6 +199,9 @@ class _Mapped:
             self.map.close()
             raise ValueError("not a ring")
         self.slots, self.capacity = slots, capacity
+        self.data_at = data_at(slots)
+        self.margin = max(1, slots // 16)  # a reader this close to being lapped drops as many
+        self.skip_below = 0  # descriptors of older messages are dropped without a look
         self.view = memoryview(self.map)
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
 
@@ -199,26 +215,54 @@ class _Buffers:
     """Buffers messages are copied into, used again once nothing refers to them any more.
 
     A fresh megabyte costs 256 page faults, more than the copy into it; so each ring size
-    keeps a few buffers. A delivery hands out a read-only view of one; the view, and every
-    numpy array a message builds on it, holds a reference, so a buffer whose only
-    reference is this pool is free (CPython's reference count says so exactly).
+    keeps enough buffers for the copies one drain holds (:data:`DRAIN_BYTES`) and a few
+    more. A delivery hands out a read-only view of one; the view, and every numpy array a
+    message builds on it, holds a reference, so a buffer whose only reference is this pool
+    is free (CPython's reference count says so exactly). Within one drain the search for a
+    free buffer goes on from the last one taken (those before it are held by the drain's
+    deliveries); each drain starts again from the first (:meth:`rewind`), so the buffers in
+    use are the same few, still in the CPU's cache.
     """
 
     def __init__(self) -> None:
-        self._pools: dict[int, list[bytearray]] = {}
+        self._pools: dict[int, _Pool] = {}
 
     def take(self, capacity: int, size: int) -> memoryview:
         """A writable view of ``size`` bytes in a buffer nobody else holds."""
-        pool = self._pools.setdefault(capacity, [])
-        for buffer in pool:
+        pool = self._pools.get(capacity)
+        if pool is None:
+            if len(self._pools) >= MAX_MAPS:
+                return memoryview(bytearray(size))  # many ring sizes at once: no pooling
+            pool = self._pools[capacity] = _Pool(POOLED + DRAIN_BYTES // capacity)
+        buffers = pool.buffers
+        count = len(buffers)
+        at = pool.next
+        for _ in range(count):
+            buffer = buffers[at]
+            at = at + 1 if at + 1 < count else 0
             if sys.getrefcount(buffer) <= _UNUSED:
+                pool.next = at
                 return memoryview(buffer)
-        if len(pool) < POOLED or len(self._pools) > MAX_MAPS:
+        if count < pool.limit:
             fresh = bytearray(capacity)
-            if len(pool) < POOLED:
-                pool.append(fresh)
+            buffers.insert(pool.next, fresh)  # the next turn goes on after it
+            pool.next = (pool.next + 1) % len(buffers)
             return memoryview(fresh)
         return memoryview(bytearray(size))  # all in use (a subscriber holds many messages)
+
+    def rewind(self) -> None:
+        """Search from the first buffer again (a drain begins)."""
+        for pool in self._pools.values():
+            pool.next = 0
+
+
+@dataclass(slots=True)
+class _Pool:
+    """The buffers of one ring size, and where the next search for a free one starts."""
+
+    limit: int
+    buffers: list[bytearray] = field(default_factory=list)
+    next: int = 0
 
 
 class RingReader:
@@ -246,19 +290,34 @@ class RingReader:
         if ring is None or size > ring.capacity:  # (writers number from 1: 0 was never written)
             self.unmapped += 1
             return None
+        if number < ring.skip_below:  # older than what this reader caught up to
+            self.overwritten += 1
+            return None
         slot = number % ring.slots
         expected = 2 * number
         generations = ring.generations
         if generations[slot] != expected:
             self.overwritten += 1
             return None
-        start = DATA_AT + slot * ring.capacity
+        # the writer is (nearly) a ring ahead: it will reuse the slot while we copy. A copy
+        # that ends torn costs as much as one that delivers (a reader a ring behind would
+        # spend all its time on such copies), so it drops a few messages to make room
+        ahead = number + ring.slots - ring.margin  # the writer has begun this message
+        if generations[(number - ring.margin) % ring.slots] >= 2 * ahead - 1:
+            ring.skip_below = number + ring.margin
+            self.overwritten += 1
+            return None
+        start = ring.data_at + slot * ring.capacity
         data = self._buffers.take(ring.capacity, size)
         data[:size] = ring.view[start : start + size]
         if generations[slot] != expected:  # reused while we copied: the copy may be torn
             self.overwritten += 1
             return None
         return data[:size].toreadonly()
+
+    def rewind(self) -> None:
+        """A drain begins: its copies go into the first free buffers again (cache-warm)."""
+        self._buffers.rewind()
 
     def _ring(self, key: tuple[int, int, int, int]) -> _Mapped | None:
         ring = self._maps.get(key)

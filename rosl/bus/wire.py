@@ -38,6 +38,7 @@ from rosl.bus.auth import MAC_SIZE
 from rosl.bus.coalesce import Batch, split_records
 from rosl.bus.fragment import Reassembler, split
 from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
+from rosl.bus.shm_ring import DRAIN_BYTES
 from rosl.bus.transport import channel_of
 
 if TYPE_CHECKING:
@@ -71,7 +72,7 @@ SILENT_NS = 10_000_000_000  # a stream silent this long is retired
 HOUSEKEEPING_NS = 250_000_000
 # one drain copies at most about this much out of shared memory: the copies of a poll are held
 # together, and fresh memory for each (page faults) costs more than the copy itself
-SHM_DRAIN_BYTES = 4 * 1024 * 1024
+SHM_DRAIN_BYTES = DRAIN_BYTES
 MAX_JUMP_LOGS = 10
 _FULL = (1 << DUP_WINDOW) - 1
 _MASK32 = 0xFFFFFFFF
@@ -430,6 +431,8 @@ class Reader:
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
         clock, streams, auth = time.time_ns, self.streams, self.auth
         copied = 0  # bytes copied out of shared memory by this call
+        if self.shm is not None:
+            self.shm.rewind()
         now = clock()
         if now >= self._next_housekeeping:
             self._housekeeping(now)
@@ -541,7 +544,7 @@ class Reader:
                     ),
                 )
             )
-            if copied > SHM_DRAIN_BYTES:
+            if copied >= SHM_DRAIN_BYTES:
                 return True  # the rest stays in the socket: copies are freed before more
         return True
 

@@ -67,6 +67,13 @@ def bus(domain_id: int) -> Iterator[tuple[MulticastTransport, Receiver]]:
         transport.close()
 
 
+def shm_writer(transport: MulticastTransport) -> Writer:
+    """A writer on TOPIC that sends large messages through shared memory."""
+    writer = Writer(transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
+    writer.use_shm(lambda: True)
+    return writer
+
+
 def pattern(index: int, size: int) -> bytes:
     return index.to_bytes(4, "little") * (size // 4)
 
@@ -111,10 +118,11 @@ def test_large_messages_with_and_without_arrays_cross_through_shared_memory(
     processes: Processes, domain_id: int
 ) -> None:
     talker, said, shm = talk(processes, 10, {})
-    assert shm == ["10", "10", "0"]  # the image and the long string as descriptors, not the small
+    # the image, the long and the mid-size string as descriptors, not the small one
+    assert shm == ["10", "10", "10", "0"]
 
     rings = sorted(Path(DIRECTORY).glob(f"rosl-u{os.geteuid()}-d{domain_id}-p{talker.pid}-*"))
-    assert len(rings) == 2, rings  # one per publisher that sent large messages
+    assert len(rings) == 3, rings  # one per publisher that sent large messages
     for ring in rings:
         assert stat.S_IMODE(ring.stat().st_mode) == 0o600
     talker.send_signal(signal.SIGINT)  # a clean close unlinks them
@@ -127,7 +135,7 @@ def test_a_subscriber_without_shared_memory_gets_the_bytes(
     processes: Processes, domain_id: int
 ) -> None:
     _, _, shm = talk(processes, 5, {"ROSL_SHM": "0"})
-    assert shm == ["0", "0", "0"]  # the listener announced no shared memory: all on the wire
+    assert shm == ["0", "0", "0", "0"]  # the listener announced no shared memory: all on the wire
 
 
 @pytest.mark.skipif(
@@ -141,7 +149,7 @@ def test_a_subscriber_with_its_own_dev_shm_gets_the_bytes(
     private = 'mount -t tmpfs -o size=16m tmpfs /dev/shm && exec "$@"'
     prefix = ("unshare", "--mount", "--propagation", "private", "sh", "-c", private, "sh")
     _, _, shm = talk(processes, 5, {}, prefix)
-    assert shm == ["0", "0", "0"]  # all on the wire
+    assert shm == ["0", "0", "0", "0"]  # all on the wire
 
 
 def test_a_slow_subscriber_never_reads_an_overwritten_slot(
@@ -166,6 +174,10 @@ def test_a_slow_subscriber_never_reads_an_overwritten_slot(
     assert overwritten >= count - 64  # a ring of 1 MB messages has 64 slots
     assert len(got) + overwritten == count
     assert min(indices) >= overwritten  # only the newest survive
+    # a reader nearly a ring behind copies nothing the writer is about to reuse: it drops a
+    # sixteenth of the ring more and reads the rest, the newest
+    assert indices == list(range(count - len(got), count))
+    assert len(got) <= 64 - 64 // 16
     assert reader.lost() == overwritten  # counted where loss is reported
     assert child.stdin is not None
     child.stdin.write("\n")
@@ -204,8 +216,7 @@ def test_a_ring_others_can_read_is_refused_and_counted(
     bus: tuple[MulticastTransport, Receiver],
 ) -> None:
     transport, receiver = bus
-    writer = Writer(transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
-    writer.use_shm(lambda: True)
+    writer = shm_writer(transport)
     writer.send(pattern(1, 100_000))
     assert transport.shm is not None
     ring = Path(transport.shm.path(SENDER, ENDPOINT, os.getpid(), 1))
@@ -268,8 +279,7 @@ def test_a_descriptor_of_message_zero_is_refused(bus: tuple[MulticastTransport, 
     from rosl.bus.shm_ring import DESCRIPTOR
 
     transport, _ = bus
-    writer = Writer(transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
-    writer.use_shm(lambda: True)
+    writer = shm_writer(transport)
     writer.send(pattern(1, 100_000))
     assert transport.shm is not None
     reader = transport.shm.reader()
@@ -323,3 +333,76 @@ def test_shared_memory_is_on_by_default_only_where_stores_stay_in_order(
     from rosl.bus.shm import enabled
 
     assert enabled({"ROSL_SHM": value}, machine) is expected
+
+
+def test_messages_above_16_kib_take_shared_memory_by_default(
+    bus: tuple[MulticastTransport, Receiver],
+) -> None:
+    from rosl.bus.shm import threshold
+
+    transport, receiver = bus
+    assert threshold({}) == 16 * 1024
+    assert transport.shm is not None
+    limit = transport.shm.threshold  # the default, unless the environment sets another
+    writer = shm_writer(transport)
+    sizes = [limit, limit + 4, 60_000]  # at the threshold: the wire; above it: shared memory
+    for index, size in enumerate(sizes):
+        writer.send(pattern(index, size))
+    # the 60 KB message outgrew the first ring, and the writer is closed before anything is
+    # read: both rings stay (for a while) until the subscriber has mapped them
+    writer.close()
+    got: list[Delivery] = []
+    while len(got) < len(sizes) and receiver.poll(5.0, got):
+        pass
+    assert [bytes(d.payload) for d in got] == [pattern(i, n) for i, n in enumerate(sizes)]
+    assert writer.shm_sent == 2
+
+
+def test_a_ring_of_many_mid_size_slots_delivers_every_message_intact(
+    bus: tuple[MulticastTransport, Receiver],
+) -> None:
+    # 20 KB messages: slots of 32 KiB, 1024 of them (their generations take three pages of
+    # the ring's header); more messages than slots, read as they come, all arrive intact
+    from rosl.bus.shm_ring import segment_size
+
+    transport, receiver = bus
+    writer = shm_writer(transport)
+    size, count, batch = 20_000, 1100, 100
+    got: list[Delivery] = []
+    for first in range(0, count, batch):
+        for index in range(first, first + batch):
+            writer.send(pattern(index, size))
+        while len(got) < first + batch and receiver.poll(5.0, got):
+            pass
+    assert [bytes(d.payload) for d in got] == [pattern(i, size) for i in range(count)]
+    assert writer.shm_sent == count
+    assert transport.shm is not None
+    ring = Path(transport.shm.path(SENDER, ENDPOINT, os.getpid(), 1))
+    assert ring.stat().st_size == segment_size(1024, 32 * 1024)
+    assert receiver.reader.lost() == 0
+
+
+def test_a_reader_nearly_lapped_drops_a_sixteenth_of_the_ring_and_reads_on() -> None:
+    # a ring of 64 slots: a reader the writer nearly laps (within 64 // 16 = 4 slots) copies
+    # nothing the writer may reuse meanwhile: it drops 4 messages and reads the next
+    from rosl.bus.shm import this_process
+    from rosl.bus.shm_ring import RingReader, RingWriter
+
+    path = os.path.join(DIRECTORY, f"rosl-test-lap-{os.getpid()}")
+    writer = RingWriter(path, this_process(), 1, 64, 4096)
+    try:
+        reader = RingReader(lambda *_: path)
+        sent = [writer.put(pattern(i, 4096)) for i in range(1, 65)]  # messages 1..64
+
+        def read(number: int) -> bool:
+            got = reader.read(SENDER, ENDPOINT, sent[number - 1])
+            assert got is None or bytes(got) == pattern(number, 4096), number
+            return got is not None
+
+        assert not read(1)  # the writer has begun message 61
+        assert [n for n in range(2, 6) if read(n)] == [5]  # 1..4 made room
+        sent += [writer.put(pattern(i, 4096)) for i in range(65, 69)]  # ..68: 6 is near again
+        assert [n for n in range(6, 69) if read(n)] == list(range(10, 69))
+        assert reader.overwritten == 4 + 4
+    finally:
+        writer.close()
