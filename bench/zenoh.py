@@ -49,6 +49,7 @@ def _config(port: int) -> object:
     config.insert_json5("connect/endpoints", f'["tcp/127.0.0.1:{port}"]')
     config.insert_json5("listen/endpoints", '["tcp/127.0.0.1:0"]')
     config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("transport/shared_memory/enabled", "false")  # as rosl's and rmw_zenoh's
     return config
 
 

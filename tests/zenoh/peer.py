@@ -65,6 +65,7 @@ def main() -> None:
     config.insert_json5("connect/endpoints", f'["tcp/127.0.0.1:{port}"]')
     config.insert_json5("listen/endpoints", '["tcp/127.0.0.1:0"]')
     config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("transport/shared_memory/enabled", "false")  # rmw_zenoh's default
     session = zenoh.open(config)
     zid = str(session.info.zid())
     node = {

@@ -64,7 +64,9 @@ class Secured:
             self.users.write_text(f"{USER}:{PASSWORD}\n")
 
     def _transport(self, password: str | None) -> dict[str, Any]:
-        transport: dict[str, Any] = {}
+        # as rmw_zenoh's files: zenoh's own shared memory off (a killed process would leave
+        # its pool in /dev/shm)
+        transport: dict[str, Any] = {"shared_memory": {"enabled": False}}
         if self.users is not None:
             auth: dict[str, str] = {"dictionary_file": str(self.users)}
             if password is not None:  # peers link to each other too: each checks the other

@@ -123,6 +123,7 @@ def test_the_peer_sees_rosl_liveliness_tokens(
     config = zenoh.Config()
     config.insert_json5("connect/endpoints", f'["{router.endpoint}"]')
     config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("transport/shared_memory/enabled", "false")  # rmw_zenoh's default
     with zenoh.open(config) as session:
 
         def tokens() -> list[str]:
