@@ -299,11 +299,11 @@ class MulticastReceiver:
         self.reader = Reader(auth)
         self._sockets: dict[int, socket.socket] = {}
         self._lock = threading.Lock()
+        self.backlog_ns = backlog_from_env()  # (a bad setting raises before the pipe exists)
         self._wake_read, self._wake_write = os.pipe()
         os.set_blocking(self._wake_read, False)
         os.set_blocking(self._wake_write, False)
         self._closed = False
-        self.backlog_ns = backlog_from_env()
         self._caught_up: dict[int, int] = {}  # socket fd -> when stale messages were skipped
         # what a poll of every channel watches, rebuilt when a channel opens or closes (not
         # per poll: a 1 kHz timer polls a thousand times a second)

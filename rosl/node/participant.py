@@ -53,7 +53,11 @@ class Participant:
     def __init__(self, domain: int | str | None = None) -> None:
         self.transport = open_transport(domain)
         self.sender = int.from_bytes(os.urandom(8), "little") | 1
-        self._receiver = self.transport.receiver()
+        try:
+            self._receiver = self.transport.receiver()
+        except BaseException:  # a bad setting (BusError): nothing left open behind it
+            self.transport.close()
+            raise
         self.reader = self._receiver.reader
         self._endpoint_ids = itertools.count(1)
         self._node_ids = itertools.count(1)

@@ -70,3 +70,32 @@ def test_a_bad_setting_in_a_command_is_one_line_and_exit_1(domain_id, name, valu
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1, done.stderr
     assert lines[0].startswith(f"{name}={value!r} is not a number of "), lines
+
+
+LEAK_CHECK = """
+import os, sys
+from rosl.bus.errors import BusError
+from rosl.node.participant import Participant
+
+before = sorted(os.listdir("/proc/self/fd"))
+for _ in range(3):
+    try:
+        Participant(int(sys.argv[1]))
+    except BusError as err:
+        print("refused:", err)
+print("open before", len(before), "after", len(os.listdir("/proc/self/fd")))
+"""
+
+
+def test_a_participant_refused_for_a_bad_setting_leaves_nothing_open(domain_id):
+    # a library user may catch the error and go on: no socket, pipe or ring left behind
+    done = subprocess.run(
+        [sys.executable, "-c", LEAK_CHECK, str(domain_id)],
+        capture_output=True, text=True, timeout=60, check=False,
+        env={**os.environ, "ROSL_BACKLOG_MS": "soon"},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0].startswith("refused: ROSL_BACKLOG_MS='soon' is not a number"), lines
+    before, after = lines[-1].split()[2], lines[-1].split()[4]
+    assert after == before, lines
