@@ -105,6 +105,9 @@ class Executor:
         self._fast_looks = 0  # ... when the timer was handed out
         self._looking = 0  # threads inside _next_work
         self._idle_at: int | None = None  # the participant's changes when a look found nothing
+        # spin_once may take the timers-only way (_spin_timers): callbacks run on this thread
+        cls = type(self)
+        self._plain = cls._run is Executor._run and cls._next_work is Executor._next_work
 
     @property
     def context(self) -> Context:
@@ -212,6 +215,10 @@ class Executor:
         forever = timeout_sec is None or timeout_sec < 0
         deadline = None if forever else time.monotonic() + (timeout_sec or 0.0)
         remaining = None if forever else timeout_sec
+        if self._quiet is not None and self._plain:
+            if self._spin_timers(deadline):
+                return
+            remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
         while True:
             try:
                 item, node = self._next_work(remaining)
@@ -224,6 +231,67 @@ class Executor:
             if not item._internal:
                 return  # rosl's own housekeeping does not count as the one callback
             remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+
+    def _spin_timers(self, deadline: float | None) -> bool:
+        """``spin_once`` for nodes that only wait for their timers; False: look the usual way.
+
+        Taken when the last wait ended at its timeout with nothing changed (``_quiet``), so
+        only time has moved: the look asks the timers, the wait polls the transport, and the
+        due timer runs here (a publisher's 1 kHz timer asks a thousand times a second, and
+        in many processes on few cores every step counts). It gives up to the usual look at
+        once when anything else may be ready: a change the participant counts, queued work,
+        a callback running, a shutdown, a lock-stepped simulator to answer. True when done:
+        a timer ran, or the time was up.
+        """
+        quiet = self._quiet
+        context = self._context
+        participant = context.participant
+        if (
+            quiet is None
+            or participant is None
+            or participant.changes != quiet[0]
+            or self._nodes is not quiet[1]
+            or self._batch
+            or self._ready_tasks
+            or self._work
+            or self._is_shutdown
+            or participant.closed
+            or not context.ok()
+        ):
+            return False
+        if self.answers_lockstep:
+            answerer = participant.answerer
+            if answerer is None or answerer.seen:
+                return False
+        changes, nodes = quiet
+        waited = False
+        self._looking += 1
+        try:
+            while True:
+                due = self._due_timer(nodes)
+                if isinstance(due, tuple):
+                    break
+                if due is None:  # no wall-time timer: the usual look waits without one
+                    return False
+                if deadline is not None:
+                    remaining = deadline - time.monotonic()
+                    if remaining <= 0 and waited:
+                        return True
+                    due = min(due, max(0.0, remaining))
+                waited = True
+                self._looks += 1
+                if participant.wait_change(due, changes):
+                    self._quiet = None
+                    return False
+        finally:
+            self._looking -= 1
+        timer, node = due
+        result = self._execute(timer, node)
+        if isinstance(result, CoroutineType):  # (as _run)
+            task: Task[Any] = Task(_given, (result,), executor=self)
+            task.entity, task.node = timer, node
+            task()
+        return not timer._internal or (deadline is not None and time.monotonic() >= deadline)
 
     def _after_external_shutdown(self) -> None:
         """``spin_once`` after the context was shut down: return once, then end the loop.

@@ -239,8 +239,19 @@ class Participant:
         """
         if self.changes != since:
             return True
-        if not self._poll_once(timeout, since):
+        lock = self._poll_lock
+        if self.closed or not lock.acquire(blocking=False):
             return self.wait(_never, timeout, since)
+        try:  # (_poll_once, one call less)
+            self._poller = threading.get_ident()
+            if self.changes == since:
+                self._poll_locked(timeout, None)
+        finally:
+            self._poller = None
+            lock.release()
+            if self._waiting:
+                with self._cond:
+                    self._cond.notify_all()
         return self.changes != since
 
     def _poll_once(self, timeout: float | None, snapshot: int) -> bool:

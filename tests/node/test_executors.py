@@ -1306,3 +1306,65 @@ def test_an_asyncio_task_can_await_a_service_future_while_another_task_spins(ros
             spinner.cancel()
 
     assert asyncio.run(run()).sum == 42
+
+
+def test_spin_once_of_a_node_that_waits_for_its_timers_still_runs_whatever_comes(ros):
+    # after a wait that ended at its timeout, spin_once takes the timers-only way: a look at
+    # the timers and a poll, no more; a message, a guard, a task, a new timer, a canceled one
+    # and a timer callback that raises must all go as on the usual way
+    from rosl.idl.registry import get_message_class
+
+    node, executor = settled(ros, "timers_only")
+    String = get_message_class("std_msgs/msg/String")
+    ticks: list[int] = []
+    node.create_timer(0.002, lambda: ticks.append(1))
+    assert spin_until(executor, lambda: len(ticks) >= 20)
+    assert executor._quiet is not None  # (the way under test was taken)
+    heard: list[str] = []
+    node.create_subscription(String, "/timers_only", lambda m: heard.append(m.data), 100)
+    talker = ros.Node("timers_only_talker").create_publisher(String, "/timers_only", 100)
+    for i in range(5):
+        threading.Thread(target=talker.publish, args=(String(data=f"m{i}"),)).start()
+        assert spin_until(executor, lambda i=i: len(heard) > i), heard
+    assert heard == [f"m{i}" for i in range(5)]
+    guarded: list[int] = []
+    guard = node.create_guard_condition(lambda: guarded.append(1))
+    assert spin_until(executor, lambda: len(ticks) >= 40)
+    threading.Thread(target=guard.trigger, daemon=True).start()
+    assert spin_until(executor, lambda: bool(guarded))
+    done: list[int] = []
+    assert spin_until(executor, lambda: len(ticks) >= 60)
+    executor.create_task(lambda: done.append(1))
+    assert spin_until(executor, lambda: bool(done))
+    other: list[int] = []
+    second = node.create_timer(0.003, lambda: other.append(1))
+    assert spin_until(executor, lambda: len(other) >= 5)
+    second.cancel()
+    stopped_at = len(other)
+    failing = node.create_timer(0.002, lambda: 1 / 0)
+    before = len(ticks)
+    assert spin_until(executor, lambda: len(ticks) >= before + 30)  # the error is logged
+    failing.cancel()
+    assert len(other) == stopped_at
+    assert guarded == [1]
+    assert done == [1]
+
+
+def test_spin_once_with_only_a_distant_timer_returns_at_its_timeout_having_run_nothing(ros):
+    node, executor = settled(ros, "distant_only")
+    ticks: list[int] = []
+    node.create_timer(3 * BOUND, lambda: ticks.append(1))
+    for _ in range(
+        4
+    ):  # the first waits end at the timeout; the later ones take the timers-only way
+        finished = threading.Event()
+
+        def spin(finished: threading.Event = finished) -> None:
+            executor.spin_once(timeout_sec=0.01)
+            finished.set()
+
+        threading.Thread(target=spin, daemon=True).start()
+        assert finished.wait(BOUND)
+    assert executor._quiet is not None
+    executor.spin_once(timeout_sec=0)
+    assert ticks == []
