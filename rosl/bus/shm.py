@@ -18,6 +18,11 @@ Where rings live: ``/dev/shm/rosl-u<uid>-d<domain>-p<pid>-<sender>-e<endpoint>-r
 mode 0600, created with ``O_EXCL|O_NOFOLLOW`` and memory reserved up front; readers open
 them only when they are regular files of their own user that nobody else can read.
 
+A ring starts at about :data:`RING_BYTES`, its slots the first message's size and an eighth
+more; a message that outgrows them gets a new ring of bigger slots, and a publisher that goes
+round its ring in less than :data:`LAP_S` one twice as deep (up to :data:`RING_MAX_BYTES`), so
+a subscriber stalled by a loaded machine still finds its messages.
+
 Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
 transport closes (and at interpreter exit); one replaced by a bigger ring, or whose publisher
 was destroyed, at the first message the transport writes :data:`RETIRE_S` seconds later or
@@ -44,6 +49,7 @@ import weakref
 from typing import TYPE_CHECKING
 
 from rosl.bus.errors import BusError
+from rosl.bus.shm_ring import MAX_SLOTS as RING_MAX_SLOTS
 from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner
 
 if TYPE_CHECKING:
@@ -57,10 +63,17 @@ DIRECTORY = "/dev/shm"
 # payload, no 64 KB datagram to copy through the kernel), and a ring's 1024 slots are 4-16
 # times the messages of 16-64 KB a 4 MiB socket buffer holds
 THRESHOLD = 16 * 1024
-RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring aims for
+RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring aims for at first
 # slack: 64 MiB of 1 MiB messages is 30 ms at 2 GB/s; 1024 of 60 KB, 60 ms at 1 GB/s
 MIN_SLOTS, MAX_SLOTS = 4, 1024
 MIN_CAPACITY = 4096
+# a ring its publisher goes round in less than LAP_S gets twice the slots, up to
+# RING_MAX_BYTES (and shm_ring's slot limit): a subscriber that a loaded machine stalls for a
+# few scheduler slices must find its messages still there (1 MiB at 4 GB/s: 64 MiB is 16 ms,
+# 256 MiB 64 ms). Slow publishers keep the small ring.
+LAP_S = 0.1
+RING_MAX_BYTES = 256 * 1024 * 1024
+HEADROOM = 8  # a slot holds the first message's size and an eighth more (pages, at least)
 SWEEP_S = 30.0
 RETIRE_S = 5.0  # a ring replaced by a bigger one (or of a closed publisher) is unlinked this late
 STALE_PARTIAL_S = 60.0  # a file with no readable header this old is a half-made ring
@@ -194,14 +207,17 @@ def sweep(directory: str = DIRECTORY, uid: int | None = None) -> list[str]:
 class SharedMemory:
     """A transport's shared memory: its publishers' rings, readers for its receivers."""
 
-    def __init__(self, domain: int, directory: str = DIRECTORY) -> None:
+    def __init__(self, domain: int, directory: str = DIRECTORY, lap_s: float = LAP_S) -> None:
         self.domain = domain
+        self.lap_s = lap_s  # a ring gone round faster gets deeper (see _lapped)
         self.directory = directory
         self.host = host_identity()
         self.threshold = threshold()
         self.uid = os.geteuid()
         self._owner = this_process()
         self._rings: dict[tuple[int, int], RingWriter] = {}
+        self._lap_started: dict[tuple[int, int], float] = {}  # when each ring's lap began
+        self._no_room: set[tuple[int, int]] = set()  # rings /dev/shm had no room to deepen
         # rings no longer written, kept until a deadline for readers that have not mapped
         # them yet (descriptors of their last messages may still wait in a socket)
         self._retired: list[tuple[float, RingWriter]] = []
@@ -231,35 +247,67 @@ class SharedMemory:
         with self._lock:
             if time.monotonic() >= self._next_due:
                 self._due()
-            ring = self._rings.get((sender, endpoint))
+            key = (sender, endpoint)
+            ring = self._rings.get(key)
             if ring is None or size > ring.capacity:
-                ring = self._grow(sender, endpoint, ring, size)
+                ring = self._grow(key, ring, size)
                 if ring is None:
                     return None
-            return ring.put(payload)
+            descriptor = ring.put(payload)
+            if not ring.written % ring.slots:  # a lap ends
+                self._lapped(key, ring)
+            return descriptor
 
-    def _grow(
-        self, sender: int, endpoint: int, old: RingWriter | None, size: int
-    ) -> RingWriter | None:
-        capacity = max(MIN_CAPACITY, 1 << (size - 1).bit_length())
+    def _grow(self, key: tuple[int, int], old: RingWriter | None, size: int) -> RingWriter | None:
+        """A ring for messages of ``size`` bytes, in place of ``old`` (None: shm is off)."""
+        capacity = max(MIN_CAPACITY, size + size // HEADROOM)
+        if old is not None:
+            capacity = max(capacity, old.capacity + old.capacity // HEADROOM)  # fewer rounds
         slots = max(MIN_SLOTS, min(MAX_SLOTS, RING_BYTES // capacity))
         incarnation = 1 if old is None else old.incarnation + 1
         if old is not None:
             self._retire(old)
-        path = self.path(sender, endpoint, self._owner.pid, incarnation)
+        path = self.path(*key, self._owner.pid, incarnation)
         try:
             ring = self._make(path, incarnation, slots, capacity)
         except OSError as err:
             self._failed = True
-            self._rings.pop((sender, endpoint), None)
+            self._rings.pop(key, None)
             print(
                 f"rosl: warning: cannot make a shared-memory ring {path} ({err.strerror}); "
                 "large messages go over the network instead",
                 file=sys.stderr,
             )
             return None
-        self._rings[(sender, endpoint)] = ring
+        self._rings[key] = ring
+        self._lap_started[key] = time.monotonic()
         return ring
+
+    def _lapped(self, key: tuple[int, int], ring: RingWriter) -> None:
+        """A lap of ``ring`` ended: one that took less than ``lap_s`` gets a ring twice as deep.
+
+        The new ring has the same slot size; the old one is retired as when a message outgrows
+        it. Where /dev/shm has no room for it, the old ring stays, and grows no more.
+        """
+        now = time.monotonic()
+        started = self._lap_started.get(key, now)
+        self._lap_started[key] = now
+        slots = min(ring.slots * 2, RING_MAX_SLOTS, RING_MAX_BYTES // ring.capacity)
+        if now - started >= self.lap_s or slots <= ring.slots or key in self._no_room:
+            return
+        incarnation = ring.incarnation + 1
+        path = self.path(*key, self._owner.pid, incarnation)
+        try:
+            bigger = self._make(path, incarnation, slots, ring.capacity)
+        except OSError:
+            bigger = None
+        if bigger is None or bigger.slots <= ring.slots:
+            if bigger is not None:
+                bigger.close()
+            self._no_room.add(key)
+            return
+        self._retire(ring)
+        self._rings[key] = bigger
 
     def _make(self, path: str, incarnation: int, slots: int, capacity: int) -> RingWriter:
         """A new ring; with fewer slots (less slack) where /dev/shm is small (a container's)."""
@@ -275,6 +323,8 @@ class SharedMemory:
         """An endpoint is gone: unlink its ring (:data:`RETIRE_S` later)."""
         with self._lock:
             ring = self._rings.pop((sender, endpoint), None)
+            self._lap_started.pop((sender, endpoint), None)
+            self._no_room.discard((sender, endpoint))
             if ring is not None:
                 self._retire(ring)
 

@@ -164,6 +164,11 @@ class RingWriter:
         generations[slot] = 2 * number
         return DESCRIPTOR.pack(self._pid, self.incarnation, number, size)
 
+    @property
+    def written(self) -> int:
+        """How many messages were written into the ring."""
+        return self._next - 1
+
     def close(self, unlink: bool = True) -> None:
         """Unmap the ring and (by default) remove its file (idempotent)."""
         if self.closed:

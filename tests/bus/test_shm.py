@@ -21,6 +21,7 @@ import pytest
 from rosl.bus.header import topic_hash
 from rosl.bus.multicast import Addressing, MulticastTransport
 from rosl.bus.shm import DIRECTORY
+from rosl.bus.shm_ring import HEADER
 from rosl.bus.transport import channel_of
 from rosl.bus.wire import Writer
 from tests.bus import shm_snippets as snippets
@@ -42,6 +43,7 @@ from rosl.bus.wire import Writer
 
 domain, count, size = (int(a) for a in sys.argv[1:4])
 transport = MulticastTransport(Addressing(domain))
+transport.shm.lap_s = 0.0  # the ring keeps its first depth however fast it is gone round
 writer = Writer(transport, 0x5151, 7, "/shm_ring", "test/msg/Bytes")
 writer.use_shm(lambda: True)
 for i in range(count):
@@ -158,7 +160,7 @@ def test_a_slow_subscriber_never_reads_an_overwritten_slot(
     _, receiver = bus
     # the writer fills its ring more than twice before this process reads anything
     count, size = 160, 1_000_000
-    out, _path, child = ring_writer(processes, domain_id, count, size)
+    out, path, child = ring_writer(processes, domain_id, count, size)
     got: list[Delivery] = []
     idle = 0
     while idle < 3:
@@ -171,13 +173,16 @@ def test_a_slow_subscriber_never_reads_an_overwritten_slot(
     for delivery, index in zip(got, indices, strict=True):
         assert bytes(delivery.payload) == pattern(index, size), f"message {index} is torn"
     assert got, "the newest ring of messages is still readable"
-    assert overwritten >= count - 64  # a ring of 1 MB messages has 64 slots
+    with open(path, "rb") as ring:
+        slots = HEADER.unpack(ring.read(HEADER.size))[1]  # 59 of 1 MB and an eighth: 64 MiB
+    assert slots < count // 2
+    assert overwritten >= count - slots
     assert len(got) + overwritten == count
     assert min(indices) >= overwritten  # only the newest survive
     # a reader nearly a ring behind copies nothing the writer is about to reuse: it drops a
     # sixteenth of the ring more and reads the rest, the newest
     assert indices == list(range(count - len(got), count))
-    assert len(got) <= 64 - 64 // 16
+    assert len(got) <= slots - slots // 16
     assert reader.lost() == overwritten  # counted where loss is reported
     assert child.stdin is not None
     child.stdin.write("\n")
@@ -361,8 +366,9 @@ def test_messages_above_16_kib_take_shared_memory_by_default(
 def test_a_ring_of_many_mid_size_slots_delivers_every_message_intact(
     bus: tuple[MulticastTransport, Receiver],
 ) -> None:
-    # 20 KB messages: slots of 32 KiB, 1024 of them (their generations take three pages of
-    # the ring's header); more messages than slots, read as they come, all arrive intact
+    # 20 KB messages: slots of 24 KiB (the size and an eighth, in pages), 1024 of them (their
+    # generations take three pages of the ring's header); more messages than slots, read as
+    # they come, all arrive intact (also when a quick lap made the ring deeper)
     from rosl.bus.shm_ring import segment_size
 
     transport, receiver = bus
@@ -378,7 +384,7 @@ def test_a_ring_of_many_mid_size_slots_delivers_every_message_intact(
     assert writer.shm_sent == count
     assert transport.shm is not None
     ring = Path(transport.shm.path(SENDER, ENDPOINT, os.getpid(), 1))
-    assert ring.stat().st_size == segment_size(1024, 32 * 1024)
+    assert ring.stat().st_size == segment_size(1024, 24 * 1024)
     assert receiver.reader.lost() == 0
 
 
@@ -406,3 +412,36 @@ def test_a_reader_nearly_lapped_drops_a_sixteenth_of_the_ring_and_reads_on() -> 
         assert reader.overwritten == 4 + 4
     finally:
         writer.close()
+
+
+def test_a_publisher_that_goes_round_its_ring_quickly_gets_a_deeper_one(tmp_path: Path) -> None:
+    # a ring lapped in less than lap_s (here: any lap) is replaced by one with twice the
+    # slots of the same size; descriptors of both rings read back intact, the old ring stays
+    # until its retirement, and a message that outgrows the slots still gets bigger ones
+    from rosl.bus.shm import SharedMemory
+    from rosl.bus.shm_ring import RingReader
+
+    if shutil.disk_usage(DIRECTORY).free < 256 * 1024 * 1024:
+        pytest.skip(f"{DIRECTORY} has less than 256 MiB free: no room for the deeper ring")
+    rings = tmp_path / "rings"
+    rings.mkdir()
+    shm = SharedMemory(domain=0, directory=str(rings), lap_s=1e9)
+    key = (SENDER, ENDPOINT)
+    try:
+        size = 17_000  # slots of 20 KiB, 1024 of them at first
+        descriptors = [shm.put(*key, pattern(i, size)) for i in range(1024 + 10)]
+        ring = shm._rings[key]
+        assert (ring.incarnation, ring.slots, ring.capacity) == (2, 2048, 20 * 1024)
+        reader = RingReader(lambda sender, endpoint, pid, n: shm.path(sender, endpoint, pid, n))
+        tail = descriptors[-40:]  # the first ring's last 30, the deeper ring's first 10
+        assert all(d is not None for d in tail)
+        got = [reader.read(*key, d) for d in tail if d is not None]
+        assert [bytes(g) if g is not None else None for g in got] == [
+            pattern(i, size) for i in range(1024 + 10 - 40, 1024 + 10)
+        ]
+        assert shm.put(*key, pattern(0, 30_000)) is not None  # outgrows: bigger slots
+        assert shm._rings[key].capacity >= 30_000
+        assert len(list(rings.iterdir())) == 3  # two retired, kept for late readers
+    finally:
+        shm.close()
+    assert list(rings.iterdir()) == []
