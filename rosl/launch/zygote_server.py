@@ -242,6 +242,7 @@ def main(argv: list[str]) -> int:
 
     child = list(request["argv"])
     sys.argv = [entry.__file__, *child]  # as `python -m rosl.pkg.entry ...` has it
+    sys.orig_argv = [sys.executable, *ENTRY, *child]  # (and its interpreter's command line)
     return entry.main(child)
 
 

@@ -36,6 +36,7 @@ import time
 print("cwd", os.getcwd())
 print("env", os.environ.get("PROBE_WORD"), os.environ.get("ROSL_SIGINT_HELD"))
 print("argv", sys.argv[1:])
+print("orig", sys.orig_argv[1:4], sys.orig_argv[-2:])
 print("leader", os.getsid(0) == os.getpid() == os.getpgid(0))
 print("stdin", sys.stdin.read() == "")
 print("parent", os.getppid())
@@ -107,6 +108,7 @@ def test_a_launched_rosl_entry_has_its_own_environment_folder_output_and_exit(
     assert f"[probe-1] cwd {cwd}" in out, launch.both()
     assert "[probe-1] env hello None" in out, launch.both()  # SIGINT was let in by the entry
     assert "[probe-1] argv ['one', 'two']" in out, launch.both()
+    assert "[probe-1] orig ['-P', '-m', 'rosl.pkg.entry'] ['one', 'two']" in out, launch.both()
     assert "[probe-1] leader True" in out, launch.both()
     assert "[failing-2] env None None" in out, launch.both()  # not the other node's variable
     forked = env["ROSL_LAUNCH_ZYGOTE"] == "1"
