@@ -241,7 +241,7 @@ class Executor:
         in many processes on few cores every step counts). It gives up to the usual look at
         once when anything else may be ready: a change the participant counts, queued work,
         a callback running, a shutdown, a lock-stepped simulator to answer. True when done:
-        a timer ran, or the time was up.
+        a user's timer ran, or the time was up.
         """
         quiet = self._quiet
         context = self._context
@@ -291,7 +291,7 @@ class Executor:
             task: Task[Any] = Task(_given, (result,), executor=self)
             task.entity, task.node = timer, node
             task()
-        return not timer._internal or (deadline is not None and time.monotonic() >= deadline)
+        return not timer._internal  # rosl's housekeeping: spin_once goes on to look for one
 
     def _after_external_shutdown(self) -> None:
         """``spin_once`` after the context was shut down: return once, then end the loop.
