@@ -74,3 +74,24 @@ def test_a_string_field_holding_something_else_names_the_field():
     object.__setattr__(message, "data", 5)
     with pytest.raises(FieldError, match=r"String\.data"):
         registry.store().class_serializer(string_cls)(message)
+
+
+KEYWORDS_MSG = """\
+byte from
+float64[] values
+string class
+geometry_msgs/Point global
+"""
+
+
+def test_fields_named_as_python_keywords_serialize_in_every_case(make_package) -> None:
+    make_package("keywords_pkg", {"msg/Keywords.msg": KEYWORDS_MSG})
+    keywords_cls = registry.get_message_class("keywords_pkg/msg/Keywords")
+    store = registry.store()
+    point = registry.get_message_class("geometry_msgs/msg/Point")(x=2.5)
+    empty = keywords_cls(from_=b"\x07", class_="c", global_=point)  # values: none made yet
+    full = keywords_cls(from_=b"\x07", class_="c", global_=point, values=[1.0, 2.0])
+    for message in (empty, full):
+        raw = store.serialize(message)
+        assert raw[4:5] == b"\x07"
+        assert store.deserialize(raw, "keywords_pkg/msg/Keywords") == message
