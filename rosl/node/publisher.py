@@ -24,6 +24,8 @@ from rosl.node.qos import MANUAL, ReliabilityPolicy, duration_ns
 _monotonic_ns = time.monotonic_ns
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
@@ -60,8 +62,9 @@ class Publisher:
             self._writer.coalesce(participant.flusher(), DEFAULT_BYTES)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
-        self._serialize = self._store.serializer(self.type_name)  # looked up once
-        self._serialize_own = self._store.class_serializer(msg_type)  # for type(msg) is msg_type
+        # for type(msg) is msg_type: made at the first publish (a node's /rosout and
+        # /parameter_events publishers may never send)
+        self._serialize_own: Callable[[Message], bytes | memoryview] = self._first_serialize
         self._history: collections.deque[tuple[int, int, bytes | memoryview]] | None = (
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
         )
@@ -114,7 +117,12 @@ class Publisher:
         if type_name != self.type_name:
             got = type_name or type(msg).__name__
             raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
-        return self._serialize(cast("Message", msg))
+        return self._store.serializer(self.type_name)(cast("Message", msg))
+
+    def _first_serialize(self, msg: Message) -> bytes | memoryview:
+        """Make the publisher's serializer (once), then serialize as it does."""
+        self._serialize_own = self._store.class_serializer(self.msg_type)
+        return self._serialize_own(msg)
 
     def publish_all(self, payloads: list[bytes], flush: bool = False) -> None:
         """Send already-serialized messages in order, as :meth:`publish` each would.
