@@ -203,7 +203,12 @@ def _continues(last_seq: int, seq: int) -> bool:
 
 
 class Writer:
-    """Sends the messages of one endpoint on the channel of its topic or service."""
+    """Sends the messages of one endpoint on the channel of its topic or service.
+
+    :meth:`send` takes every option; ``send_plain(payload)`` is ``send(payload)`` without
+    them (a publisher's messages), by the way the writer's settings pick when they change
+    (:meth:`_choose`): a small message becomes its datagram in a few calls.
+    """
 
     def __init__(
         self,
