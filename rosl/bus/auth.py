@@ -43,7 +43,7 @@ from blake3 import blake3
 from rosl.bus.errors import BusError
 
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Mapping, Sequence
 
     from rosl.bus.transport import Buffer
 
@@ -92,6 +92,17 @@ class Auth:
         small = self._small.copy()
         small.update(body)
         return body + small.digest()
+
+    def small_signer(self) -> Callable[[bytes], bytes]:
+        """:meth:`signed` for datagrams of at most :data:`SMALL` bytes (the caller knows)."""
+        copy = self._small.copy
+
+        def sign(body: bytes) -> bytes:
+            small = copy()
+            small.update(body)
+            return body + small.digest()
+
+        return sign
 
     def verify(self, datagram: bytes) -> bool:
         """Whether a datagram's trailing MAC is right for the rest of it."""

@@ -30,7 +30,7 @@ from rosl.bus.transport import CHANNELS, channel_of
 from rosl.bus.wire import Reader
 
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Mapping, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.transport import Buffer
@@ -245,11 +245,30 @@ class MulticastTransport:
         except (BlockingIOError, InterruptedError):
             self.send_errors += 1
         except OSError as err:
-            if self._sender.fileno() < 0:
-                return  # closed during shutdown
-            raise BusError(
-                f"cannot send to {target[0]}:{target[1]} ({err.strerror}); {FIX_HINT}"
-            ) from None
+            self._failed(err, target)
+
+    def datagram_sender(self, channel: int) -> Callable[[Buffer], None]:
+        """:meth:`send` of one whole datagram on ``channel``, its lookups done once (a writer's)."""
+        target = self._targets[channel]
+        sendto = self._sender.sendto
+
+        def send_one(data: Buffer) -> None:
+            try:
+                sendto(data, target)
+            except (BlockingIOError, InterruptedError):
+                self.send_errors += 1
+            except OSError as err:
+                self._failed(err, target)
+
+        return send_one
+
+    def _failed(self, err: OSError, target: tuple[str, int]) -> None:
+        """A send failed for another reason than a full buffer: an error, unless shut down."""
+        if self._sender.fileno() < 0:
+            return  # closed during shutdown
+        raise BusError(
+            f"cannot send to {target[0]}:{target[1]} ({err.strerror}); {FIX_HINT}"
+        ) from None
 
     def receiver(self) -> MulticastReceiver:
         """A new receiver (its sockets are opened as it joins channels)."""

@@ -16,9 +16,11 @@ nodes, other hosts). The environment variable ``ROSL_TRANSPORT`` picks one (``mu
 kind)``, called for every new writer: the Zenoh transport learns its key expression there;
 and ``direct_sender(topic, sender, endpoint, kind)``, which may return a function
 ``(payload, seq, stamp)`` that a writer of an unsigned transport calls for its plain messages
-instead of making a datagram (the Zenoh transport's puts); and ``shm`` (a
-:class:`rosl.bus.shm.SharedMemory`, or None): the multicast transport's rings for large
-messages between processes of one host (writers opt in with ``use_shm``).
+instead of making a datagram (the Zenoh transport's puts); ``datagram_sender(channel)``,
+which returns ``send(channel, [datagram])`` for one channel as a function of the datagram
+with its look-ups done once (the multicast transport's, for a writer's small messages); and
+``shm`` (a :class:`rosl.bus.shm.SharedMemory`, or None): the multicast transport's rings for
+large messages between processes of one host (writers opt in with ``use_shm``).
 """
 
 from __future__ import annotations

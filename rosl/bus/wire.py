@@ -26,6 +26,7 @@ Callbacks run on the thread that polls; nothing is handed off.
 from __future__ import annotations
 
 import itertools
+import struct
 import sys
 import threading
 import time
@@ -34,7 +35,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 from rosl.bus import header as hdr
-from rosl.bus.auth import MAC_SIZE
+from rosl.bus.auth import MAC_SIZE, SMALL
 from rosl.bus.coalesce import Batch, split_records
 from rosl.bus.fragment import Reassembler, split
 from rosl.bus.header import ADDRESS, ADDRESS_SIZE, HEADER, HEADER_SIZE, Flags, Kind
@@ -43,7 +44,7 @@ from rosl.bus.transport import channel_of
 
 if TYPE_CHECKING:
     import mmap
-    from collections.abc import Callable
+    from collections.abc import Callable, Sequence
 
     from rosl.bus.auth import Auth
     from rosl.bus.coalesce import Flusher
@@ -52,6 +53,12 @@ if TYPE_CHECKING:
     from rosl.bus.transport import Buffer, Transport
 
 _SMALL = 2048  # below this, joining header and payload beats a scatter send
+# HEADER in three runs: the fields a writer's plain messages share up to ``seq`` (magic,
+# version, kind, flags, count, sender) and after it (topic, type, index, endpoint), packed once
+_HEAD_START = struct.Struct("<2sBBBxHQ")
+_HEAD_END = struct.Struct("<QIHH")
+_PLAIN = struct.Struct(f"<{_HEAD_START.size}sI{_HEAD_END.size}sIq")  # start, seq, end, total, stamp
+_time_ns = time.time_ns
 _unpack_header = HEADER.unpack_from
 _new_tuple = tuple.__new__  # builds a Delivery without its Python-level __new__ (per message)
 _MAGIC = hdr.MAGIC
@@ -196,7 +203,12 @@ def _continues(last_seq: int, seq: int) -> bool:
 
 
 class Writer:
-    """Sends the messages of one endpoint on the channel of its topic or service."""
+    """Sends the messages of one endpoint on the channel of its topic or service.
+
+    :meth:`send` takes every option; ``send_plain(payload)`` is ``send(payload)`` without
+    them (a publisher's messages), by the way the writer's settings pick when they change
+    (:meth:`_choose`): a small message becomes its datagram in a few calls.
+    """
 
     def __init__(
         self,
@@ -219,7 +231,7 @@ class Writer:
         self._seq = itertools.count(1)
         self.sent = 0
         self.last_seq = 0  # the sequence number of the last message sent
-        self.flags = 0  # extra header flags for every message (Flags.LOCKSTEP)
+        self._flags = 0
         self.batch: Batch | None = None
         self.auth: Auth | None = transport.auth
         self._signed = 0 if self.auth is None else _SIGNED
@@ -234,10 +246,54 @@ class Writer:
         direct = getattr(transport, "direct_sender", None)
         if direct is not None and self.auth is None:
             self._direct = direct(self.topic, sender, endpoint, int(kind))
+        # a plain message's datagram in one call per step: the header's two constant runs,
+        # the transport's send of one buffer on this channel, the MAC
+        one = getattr(transport, "datagram_sender", None)
+        self._emit: Callable[[Buffer], None] = (
+            _one_part(transport.send, self.channel) if one is None else one(self.channel)
+        )
+        self._sign: Callable[[bytes], bytes] | None = (
+            None if self.auth is None else self.auth.small_signer()
+        )
+        self._head_end = _HEAD_END.pack(self.topic, self.type, 0, endpoint)
+        self._head_start = b""
+        self._plain_below = 0
+        self.send_plain: Callable[[Buffer], int] = self.send
+        self._choose()
+
+    @property
+    def flags(self) -> int:
+        """Extra header flags for every message (Flags.LOCKSTEP)."""
+        return self._flags
+
+    @flags.setter
+    def flags(self, value: int) -> None:
+        self._flags = int(value)
+        self._choose()
+
+    def _choose(self) -> None:
+        """Pick :meth:`send_plain`'s way for the writer's settings (on every change of them)."""
+        flags, batch = self._flags, self.batch
+        self._head_start = _HEAD_START.pack(
+            _MAGIC, _VERSION, self.kind, flags | self._signed, 1, self.sender
+        )
+        below = min(_SMALL, self.chunk + 1)
+        if self._sign is not None:  # its datagram within what small_signer signs
+            below = min(below, SMALL - HEADER_SIZE + 1)
+        if self.shm is not None:
+            below = min(below, self.shm.threshold + 1)
+        self._plain_below = below
+        if self._direct is not None and not flags and batch is None:
+            self.send_plain = self._send_direct
+        elif batch is not None and not flags:
+            self.send_plain = self._send_batched
+        else:
+            self.send_plain = self._send_datagram
 
     def coalesce(self, flusher: Flusher, limit: int) -> None:
         """Send small messages in batches of up to ``limit`` bytes (see ``coalesce.py``)."""
         self.batch = Batch(self._send_batch, min(limit, self.chunk), flusher)
+        self._choose()
 
     def use_shm(self, gate: Callable[[], bool]) -> None:
         """Send large messages through shared memory while ``gate()`` allows it.
@@ -248,6 +304,7 @@ class Writer:
         shm = getattr(self.transport, "shm", None)
         if shm is not None and self.kind == Kind.DATA:
             self.shm, self._shm_gate = shm, gate
+            self._choose()
 
     def close(self) -> None:
         """Release what the writer holds beyond the transport (its shared-memory ring)."""
@@ -277,6 +334,43 @@ class Writer:
             parts.append(self.auth.mac_parts(parts))
         self.transport.send(self.channel, parts)
 
+    # --- send_plain: send(payload) with no options, by the writer's settings (see _choose) -----
+
+    def _send_datagram(self, payload: Buffer) -> int:
+        """A small plain message as one datagram; anything else as :meth:`send` does."""
+        total = len(payload)
+        if total >= self._plain_below:  # shared memory, a scatter send, fragments
+            return self.send(payload)
+        number = next(self._seq) & _MASK32
+        data = _PLAIN.pack(self._head_start, number, self._head_end, total, _time_ns()) + payload
+        sign = self._sign
+        self._emit(data if sign is None else sign(data))
+        self.sent += 1
+        self.last_seq = number
+        return number
+
+    def _send_direct(self, payload: Buffer) -> int:
+        """A plain message through the transport's direct sender (no rosl header)."""
+        direct = self._direct
+        if direct is None:  # (never: chosen only with one)
+            return self.send(payload)
+        number = next(self._seq) & _MASK32
+        direct(payload, number, _time_ns())
+        self.sent += 1
+        self.last_seq = number
+        return number
+
+    def _send_batched(self, payload: Buffer) -> int:
+        """A plain message into the batch when it fits; else as :meth:`send` does."""
+        batch = self.batch
+        if batch is None or not batch.fits(len(payload)):
+            return self.send(payload)
+        number = next(self._seq) & _MASK32
+        batch.add(number, _time_ns(), payload)
+        self.sent += 1
+        self.last_seq = number
+        return number
+
     def send(
         self,
         payload: Buffer,
@@ -297,7 +391,7 @@ class Writer:
                 first message only when its stamp is within ``FRESH_NS`` of their clock.
         """
         number = (next(self._seq) if seq is None else seq) & 0xFFFFFFFF
-        flags = self.flags
+        flags = self._flags
         direct = self._direct
         if direct is not None and kind is None and address is None and not (flags or self.batch):
             direct(payload, number, time.time_ns() if stamp is None else stamp)
@@ -371,7 +465,7 @@ class Writer:
             if flush:
                 self.flush()
             return
-        if batch is None or self.flags or not batch.fits(max(map(len, payloads))):
+        if batch is None or self._flags or not batch.fits(max(map(len, payloads))):
             for payload in payloads:  # (a big one keeps its place)
                 self.send(payload)
             if flush:
@@ -758,6 +852,17 @@ def _seen(stats: StreamStats, seq: int) -> bool:
 
 def _never() -> bool:
     return False
+
+
+def _one_part(
+    send: Callable[[int, Sequence[Buffer]], None], channel: int
+) -> Callable[[Buffer], None]:
+    """A transport's ``send`` of one buffer on one channel (one without ``datagram_sender``)."""
+
+    def emit(data: Buffer) -> None:
+        send(channel, (data,))
+
+    return emit
 
 
 def _log(line: str) -> None:

@@ -11,7 +11,8 @@ its ``ParameterEvent``) need not load numpy, a fifth of its start-up. So:
 * :func:`install` wraps rosbags' one compiling function so the ``import numpy`` line is dropped
   and the functions find ``numpy`` as :data:`SERDE_NUMPY` instead: numpy's own attributes
   (loading numpy then), except ``numpy.uint8`` while numpy is not loaded, which only an empty
-  sequence (:data:`rosl.idl.sequences.EMPTY`) can be asked to be viewed as.
+  sequence (:data:`rosl.idl.sequences.EMPTY`) can be asked to be viewed as. Once numpy is
+  loaded, the functions see numpy itself (no call per attribute).
 
 Used by ``store.py`` only. rosbags is pinned to a minor version whose generated code this
 matches; if its compiling function is not found, numpy is simply imported as before.
@@ -45,13 +46,21 @@ _IMPORT_LINE = "import numpy"
 _GENERATORS = ("rosbags.serde.cdr", "rosbags.serde.ros1")
 
 
+_compiled: list[ModuleType] = []  # the generated modules still seeing SERDE_NUMPY
+
+
 class _SerdeNumpy:
-    """What the generated functions see as ``numpy``."""
+    """What the generated functions see as ``numpy`` until numpy is loaded, then numpy itself."""
 
     def __getattr__(self, name: str) -> Any:
         if name == "uint8" and "numpy" not in sys.modules:
             return "uint8"  # the view of an empty sequence: no numpy array exists yet
-        return getattr(np, name)
+        value = getattr(np, name)
+        loaded = sys.modules.get("numpy")
+        if loaded is not None:  # no call through here any more (one per array per message)
+            while _compiled:
+                _compiled.pop().numpy = loaded  # type: ignore[attr-defined]
+        return value
 
 
 SERDE_NUMPY = _SerdeNumpy()
@@ -63,6 +72,7 @@ def _without_numpy_import(
     def compile_lazily(lines: list[str]) -> ModuleType:
         module = compile_lines([line for line in lines if line != _IMPORT_LINE])
         module.numpy = SERDE_NUMPY  # type: ignore[attr-defined]
+        _compiled.append(module)
         return module
 
     compile_lazily.rosl_lazy = True  # type: ignore[attr-defined]

@@ -16,6 +16,7 @@ from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from rosl.idl.errors import FieldError, InterfaceError
+from rosl.idl.flat_serde import flat_serializer
 from rosl.idl.lazy_serde import LazyTypestore
 from rosl.idl.lazy_serde import install as serde_without_eager_numpy
 from rosl.idl.messages import DUMMY_FIELD, check_fields
@@ -24,6 +25,7 @@ from rosl.idl.wire_view import wire_view
 
 if TYPE_CHECKING:
     import mmap
+    from collections.abc import Callable
 
     from rosl.idl.messages import Message
     from rosl.idl.parser import MessageSpec
@@ -61,6 +63,13 @@ def typesdict_entry(spec: MessageSpec) -> tuple[list[Any], list[Any]]:
     return constants, fields
 
 
+_Serializers = tuple[
+    "Callable[[Message], bytes | memoryview]",  # any message of the type
+    "Callable[[Message], bytes | memoryview]",  # one of the registered class (checked before)
+    "type[Message]",  # the registered class
+]
+
+
 class Store:
     """The process-wide registry of CDR serializers for the types in use."""
 
@@ -69,6 +78,7 @@ class Store:
         self._typestore: Typestore = LazyTypestore()
         self._lock = threading.Lock()
         self._checked: set[str] = set()
+        self._serializers: dict[str, _Serializers] = {}
         self._schemas: dict[tuple[str, str, str], Typestore] = {}  # a recording's definitions
 
     def __contains__(self, type_name: str) -> bool:
@@ -81,6 +91,7 @@ class Store:
             self._typestore.types[spec.type_name] = cls
             if any(f.type.string_bound or f.type.array is ArrayKind.BOUNDED for f in spec.fields):
                 self._checked.add(spec.type_name)
+            self._serializers.pop(spec.type_name, None)
 
     def serialize(self, message: Message) -> bytes:
         """Serialize a message to CDR (little endian, with the 4-byte encapsulation header).
@@ -88,7 +99,7 @@ class Store:
         Raises:
             FieldError: a field holds a value its type cannot carry; the error names it.
         """
-        return bytes(self.serialize_view(message))
+        return bytes(self.serializer(message.__msgtype__)(message))
 
     def serialize_view(self, message: Message) -> memoryview:
         """Serialize as :meth:`serialize` does, as a read-only view of the new buffer.
@@ -99,15 +110,80 @@ class Store:
         Raises:
             FieldError: a field holds a value its type cannot carry; the error names it.
         """
-        type_name = message.__msgtype__
-        if type_name in self._checked:
-            check_fields(message)
-        try:
-            wire = wire_view(message)  # byte fields as rosbags holds them
-            return self._typestore.serialize_cdr(wire, type_name, little_endian=True)
-        except _SERIALIZE_ERRORS as err:
-            check_fields(message)
-            raise FieldError(f"cannot serialize {type_name}: {err}") from err
+        return memoryview(self.serializer(message.__msgtype__)(message))
+
+    def serializer(self, type_name: str) -> Callable[[Message], bytes | memoryview]:
+        """The function :meth:`serialize_view` calls for messages of ``type_name`` (made once).
+
+        For a caller serializing one type again and again: what does not change per message
+        is looked up here once, and a flat type's messages of the type's own class are packed
+        by :mod:`rosl.idl.flat_serde`. The result is the CDR bytes (read-only: bytes, or a
+        view of a new buffer).
+
+        Raises:
+            KeyError: ``type_name`` is not registered.
+            FieldError: (from the function) a field holds a value its type cannot carry.
+        """
+        return self._serializers_of(type_name)[0]
+
+    def class_serializer(self, cls: type[Message]) -> Callable[[Message], bytes | memoryview]:
+        """:meth:`serializer` for messages whose class is exactly ``cls`` (the caller checks).
+
+        A publisher checks the class anyway: for the registered class of a flat type, this is
+        the flat serializer alone (with the errors named as :meth:`serialize` names them).
+        """
+        generic, own, registered = self._serializers_of(cls.__msgtype__)
+        return own if cls is registered else generic
+
+    def _serializers_of(self, type_name: str) -> _Serializers:
+        made = self._serializers.get(type_name)
+        if made is None:
+            made = self._serializers[type_name] = self._make_serializers(type_name)
+        return made
+
+    def _make_serializers(self, type_name: str) -> _Serializers:
+        typestore = self._typestore
+        msgdef = typestore.get_msgdef(type_name)
+        getsize, write = msgdef.getsize_cdr, msgdef.serialize_cdr_le
+        cls = cast("type[Message]", typestore.types[type_name])
+        # messages of the registered class with no byte field and no lazily empty sequence
+        # anywhere inside are read by rosbags as they are (see wire_view)
+        special = getattr(cls, "_has_bytes", True) or getattr(cls, "_has_sequences", True)
+        plain = None if special else cls
+        flat = None if plain is None else flat_serializer(cls)
+        checked = type_name in self._checked
+
+        def failed(message: Message, err: Exception) -> FieldError:
+            check_fields(message)  # names the field when it can
+            return FieldError(f"cannot serialize {type_name}: {err}")
+
+        def serialize(message: Message) -> bytes | memoryview:
+            if checked:
+                check_fields(message)
+            try:
+                if type(message) is plain:
+                    if flat is not None:
+                        return flat(message)
+                    wire = message
+                else:
+                    wire = wire_view(message)
+                raw = memoryview(bytearray(4 + getsize(0, wire, typestore)))
+                raw[1] = 1  # the encapsulation header: CDR, little endian
+                write(raw[4:], 0, wire, typestore)
+            except _SERIALIZE_ERRORS as err:
+                raise failed(message, err) from err
+            return raw.toreadonly()
+
+        if flat is None or checked:
+            return serialize, serialize, cls
+
+        def serialize_own(message: Message) -> bytes:
+            try:
+                return flat(message)
+            except _SERIALIZE_ERRORS as err:
+                raise failed(message, err) from err
+
+        return serialize, serialize_own, cls
 
     def deserialize(
         self, data: bytes | bytearray | memoryview | mmap.mmap, type_name: str

@@ -12,7 +12,7 @@ from __future__ import annotations
 import collections
 import os
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from rosl.bus.coalesce import DEFAULT_BYTES, Flusher
 from rosl.bus.header import Kind
@@ -21,7 +21,11 @@ from rosl.graph.records import PUBLISHER, SUBSCRIPTION, EndpointRecord
 from rosl.idl import registry
 from rosl.node.qos import MANUAL, ReliabilityPolicy, duration_ns
 
+_monotonic_ns = time.monotonic_ns
+
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
@@ -58,6 +62,9 @@ class Publisher:
             self._writer.coalesce(participant.flusher(), DEFAULT_BYTES)
         self._store = registry.store()
         self.digest = registry.digest(self.type_name)
+        # for type(msg) is msg_type: made at the first publish (a node's /rosout and
+        # /parameter_events publishers may never send)
+        self._serialize_own: Callable[[Message], bytes | memoryview] = self._first_serialize
         self._history: collections.deque[tuple[int, int, bytes | memoryview]] | None = (
             collections.deque(maxlen=max(1, qos.depth)) if qos.keeps_history else None
         )
@@ -76,6 +83,7 @@ class Publisher:
         self._lifespan_ns = duration_ns(qos.lifespan)
         self._lease_ns = duration_ns(qos.liveliness_lease_duration)
         self._manual = qos.liveliness in MANUAL
+        self._keeps = self._manual or self._history is not None  # publish records more
         self._announced_ns = 0  # when assert_liveliness last told the subscriptions
 
     @property
@@ -85,20 +93,36 @@ class Publisher:
 
     def publish(self, msg: Message | bytes | bytearray | memoryview) -> None:
         """Send one message (or already-serialized CDR bytes); never blocks on subscribers."""
-        data: bytes | memoryview
-        if isinstance(msg, (bytes, bytearray, memoryview)):
-            data = bytes(msg)
+        if type(msg) is self.msg_type:  # the common case, checked no further
+            data: bytes | memoryview = self._serialize_own(msg)  # bytes or a view: any sends
         else:
-            if getattr(msg, "__msgtype__", None) != self.type_name:
-                got = getattr(msg, "__msgtype__", type(msg).__name__)
-                raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
-            data = self._store.serialize_view(msg)  # no copy into bytes: any buffer sends
-        seq = self._writer.send(data)
-        now = self.last_published_ns = time.monotonic_ns()
-        if self._manual:
-            self.last_asserted_ns, self.alive = now, True
-        if self._history is not None:
-            self._history.append((seq, now, data))
+            data = self._payload(msg)
+        seq = self._writer.send_plain(data)
+        now = self.last_published_ns = _monotonic_ns()
+        if self._keeps:
+            if self._manual:
+                self.last_asserted_ns, self.alive = now, True
+            if self._history is not None:
+                self._history.append((seq, now, data))
+
+    def _payload(self, msg: object) -> bytes | memoryview:
+        """What :meth:`publish` sends for anything but a message of the publisher's class.
+
+        Raises:
+            TypeError: ``msg`` is neither bytes nor a message of the publisher's type.
+        """
+        if isinstance(msg, (bytes, bytearray, memoryview)):
+            return bytes(msg)
+        type_name = getattr(msg, "__msgtype__", None)
+        if type_name != self.type_name:
+            got = type_name or type(msg).__name__
+            raise TypeError(f"publisher on {self.topic} sends {self.type_name}, not {got}")
+        return self._store.serializer(self.type_name)(cast("Message", msg))
+
+    def _first_serialize(self, msg: Message) -> bytes | memoryview:
+        """Make the publisher's serializer (once), then serialize as it does."""
+        self._serialize_own = self._store.class_serializer(self.msg_type)
+        return self._serialize_own(msg)
 
     def publish_all(self, payloads: list[bytes], flush: bool = False) -> None:
         """Send already-serialized messages in order, as :meth:`publish` each would.

@@ -175,6 +175,18 @@ def test_only_datagrams_under_the_readers_key_are_delivered(pair: Pair) -> None:
     assert pair.reader.received() == 3
 
 
+def test_plain_messages_of_every_size_are_signed_and_checked_under_the_key(pair: Pair) -> None:
+    stranger = Writer(pair.tx_mallory, 0xBAD, 1, TOPIC, TYPE)
+    sizes = (0, 5, 1999, 2000, 2001, 2047, 2048, 3000, 70_000)  # 2000 + the header: auth.SMALL
+    for size in sizes:
+        stranger.send_plain(b"s" * size)
+        pair.writer.send_plain(b"a" * size)
+    got = pair.collector.wait_count(len(sizes), timeout=10.0)
+    assert [(d.sender, bytes(d.payload)) for d in got] == [(0xA11CE, b"a" * n) for n in sizes]
+    assert pair.collector.wait_for(lambda _: pair.reader.forged == len(sizes) + 1)  # 2 fragments
+    assert pair.reader.received() == len(sizes)
+
+
 def test_a_tampered_datagram_is_forged_even_with_the_signed_flag(pair: Pair) -> None:
     payload = b"hello"
     head = HEADER.pack(

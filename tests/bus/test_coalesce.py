@@ -102,6 +102,19 @@ def test_small_messages_share_datagrams_and_arrive_whole_in_order(counted: Count
     assert records == [(n + 1, s, p) for n, (s, p) in enumerate(zip(stamps, payloads, strict=True))]
 
 
+def test_plain_sends_share_datagrams_and_a_big_one_keeps_its_place(counted: Counted) -> None:
+    payloads = [payload_of(64, seed=n) for n in range(300)]
+    payloads[150] = payload_of(LIMIT + 1, seed=150)  # too big for a batch
+    numbers = [counted.bus.writer.send_plain(p) for p in payloads]
+    got = counted.bus.collector.wait_count(300, timeout=20.0)
+    assert [bytes(d.payload) for d in got] == payloads
+    assert [d.seq for d in got] == numbers == list(range(1, 301))
+    assert all(d.flags == 0 for d in got)
+    datagrams = counted.datagrams()
+    batches = batched_records([d for d in datagrams if HEADER.unpack_from(d)[3] & Flags.BATCH])
+    assert [r[0] for b in batches for r in b] == [n for n in numbers if n != 151]
+
+
 def test_only_the_size_bound_splits_batches_while_the_delay_has_not_passed(
     domain_id: int,
 ) -> None:

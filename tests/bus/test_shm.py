@@ -363,6 +363,33 @@ def test_messages_above_16_kib_take_shared_memory_by_default(
     assert writer.shm_sent == 2
 
 
+def test_plain_sends_above_a_low_threshold_take_shared_memory(
+    domain_id: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ROSL_SHM_THRESHOLD", "1000")  # below where a plain send joins buffers
+    transport = MulticastTransport(Addressing(domain_id))
+    try:
+        if transport.shm is None:
+            pytest.skip("no shared memory on this machine")
+        receiver = transport.receiver()
+        topic = topic_hash(TOPIC)
+        receiver.reader.wanted.add(topic)
+        receiver.join(channel_of(topic))
+        writer = shm_writer(transport)
+        sizes = [10, 1000, 1004, 1500]
+        for index, size in enumerate(sizes):
+            writer.send_plain(pattern(index, size))
+        got: list[Delivery] = []
+        while len(got) < len(sizes) and receiver.poll(5.0, got):
+            pass
+        assert [bytes(d.payload) for d in got] == [pattern(i, n) for i, n in enumerate(sizes)]
+        assert [d.seq for d in got] == [1, 2, 3, 4]
+        assert writer.shm_sent == 2
+        writer.close()
+    finally:
+        transport.close()
+
+
 def test_a_ring_of_many_mid_size_slots_delivers_every_message_intact(
     bus: tuple[MulticastTransport, Receiver],
 ) -> None:

@@ -168,6 +168,49 @@ def test_last_seq_follows_the_writers_own_numbers(bus: Bus) -> None:
     assert got[2].flags & Flags.ADDRESSED
 
 
+# --- send_plain: a publisher's messages -------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "size",
+    [0, 10, 1999, 2000, 2047, 2048, CHUNK, CHUNK + 1, 64 * 1024 + 1],
+    ids=["0", "10B", "1999", "2000", "2047", "2048", "chunk", "chunk+1", "64KiB+1"],
+)
+def test_send_plain_delivers_what_send_does_in_one_numbered_stream(bus: Bus, size: int) -> None:
+    payload = payload_of(size, seed=size)
+    before = time.time_ns()
+    numbers = [
+        bus.writer.send_plain(payload),
+        bus.writer.send(payload),
+        bus.writer.send_plain(memoryview(payload).toreadonly()),
+        bus.writer.send_plain(bytearray(payload)),
+    ]
+    after = time.time_ns()
+    got = bus.collector.wait_count(4, timeout=10.0)
+    assert [bytes(d.payload) for d in got] == [payload] * 4
+    assert [d.seq for d in got] == numbers == [1, 2, 3, 4]
+    for d in got:
+        assert (d.kind, d.sender, d.endpoint, d.flags, d.address) == (
+            Kind.DATA, SENDER, ENDPOINT, 0, None
+        )  # fmt: skip
+        assert (d.topic, d.type) == (topic_hash(TOPIC), type_hash(TYPE))
+        assert before <= d.stamp <= after
+    assert (bus.writer.sent, bus.writer.last_seq) == (4, 4)
+    assert bus.reader.lost() == 0
+
+
+def test_send_plain_follows_the_writers_flags_as_they_change(bus: Bus) -> None:
+    bus.writer.send_plain(b"before")
+    bus.writer.flags = Flags.LOCKSTEP
+    bus.writer.send_plain(b"tick")
+    bus.writer.send_plain(payload_of(CHUNK * 2))
+    bus.writer.flags = 0
+    bus.writer.send_plain(b"after")
+    got = bus.collector.wait_count(4, timeout=5.0)
+    assert [d.flags for d in got] == [0, Flags.LOCKSTEP, Flags.LOCKSTEP, 0]
+    assert bytes(got[2].payload) == payload_of(CHUNK * 2)
+
+
 # --- loss counting ----------------------------------------------------------------------------
 
 
@@ -629,6 +672,11 @@ def test_send_after_close_is_silent(domain_id: int) -> None:
     t.close()
     t.send(1, [b"after close"])
     t.send(1, [b"a", b"b"])
+    t.datagram_sender(1)(b"after close")
+    made_before = MulticastTransport(Addressing(domain_id))
+    send_one = made_before.datagram_sender(2)
+    made_before.close()
+    send_one(b"after close")
 
 
 def test_drain_respects_its_limit(bus: Bus) -> None:
