@@ -332,11 +332,14 @@ class Participant:
         channels = self._receiver.poll(timeout, deliveries, None, limits)
         if channels > 1:
             deliveries.sort(key=_send_order)  # in the order they were sent, across channels
-        for delivery in deliveries:
-            if sink is not None:
+        if sink is not None:
+            for delivery in deliveries:
                 sink(delivery)
-            else:
-                self.dispatch(delivery)
+        else:
+            handlers = self._handlers  # (dispatch, one call less per message)
+            for delivery in deliveries:
+                for handler in handlers.get(delivery.topic, ()):
+                    handler.deliver(delivery)
         if deliveries:
             self.changes += 1  # queues filled: waiters look again
         return len(deliveries)
