@@ -102,8 +102,9 @@ _held = threading.local()  # .groups: the groups of the callbacks running on thi
 
 def held_groups() -> list[CallbackGroup]:
     """This thread's stack of the groups its running callbacks hold (push, run, pop)."""
-    groups: list[CallbackGroup] | None = getattr(_held, "groups", None)
-    if groups is None:
+    try:
+        groups: list[CallbackGroup] = _held.groups  # (per callback: no getattr with a default)
+    except AttributeError:
         groups = _held.groups = []
     return groups
 
