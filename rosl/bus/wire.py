@@ -480,7 +480,7 @@ class Reader:
                 if copied >= SHM_DRAIN_BYTES:
                     return True  # the rest stays in the socket: copies are freed before more
                 continue
-            # the common case, a whole message on a topic (what _take does for it, with the
+            # the common case, a whole message on a topic (what _accept does for it, with the
             # window's usual step inline)
             stats = streams.get((sender, endpoint))
             if stats is None:
