@@ -17,9 +17,11 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 from functools import partial
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Flags, Kind, topic_hash, type_hash
+from rosl.bus.wire import Delivery
 from rosl.graph.records import LOST_FROM, PUBLISHER, SUBSCRIPTION, EndpointRecord, gid
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
@@ -30,7 +32,6 @@ from rosl.node.qos_compatibility import compatible
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from rosl.bus.wire import Delivery
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
@@ -38,6 +39,7 @@ if TYPE_CHECKING:
 
 _REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster than enums
 _monotonic_ns = time.monotonic_ns
+_KIND_OF = itemgetter(Delivery._fields.index("kind"))  # (read in C, per message)
 _LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
 KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
@@ -117,7 +119,8 @@ class Subscription(Queued):
         self.log_loss = True  # False for tools that report loss in their own words (echo)
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
-        self._queue_in(deque(maxlen=queue_depth(qos)))
+        self._depth = queue_depth(qos)
+        self._queue_in(deque(maxlen=self._depth))
         self._keeps_history = qos.keeps_history
         self._what = topic
         self.received = 0
@@ -168,6 +171,23 @@ class Subscription(Queued):
         if len(queue) == queue.maxlen:
             self.dropped += 1
         queue.append(delivery)
+
+    def deliver_all(self, deliveries: list[Delivery]) -> None:
+        """Queue a poll's deliveries for this topic at once: what :meth:`deliver` of each does."""
+        count = len(deliveries)
+        if self.destroyed or list(map(_KIND_OF, deliveries)).count(_DATA) != count:
+            for delivery in deliveries:  # (replays, or nothing: one at a time)
+                self.deliver(delivery)
+            return
+        now = self.last_arrival_ns = _monotonic_ns()
+        if self.peer_seen is not None:
+            for delivery in deliveries:
+                self._seen(delivery, now)
+        queue = self._queue
+        pushed_out = len(queue) + count - self._depth  # (the oldest go, new ones too if many)
+        if pushed_out > 0:
+            self.dropped += pushed_out
+        queue.extend(deliveries)
 
     def _seen(self, delivery: Delivery, now_ns: int) -> None:
         seen = self.peer_seen
