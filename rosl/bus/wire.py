@@ -59,13 +59,17 @@ _HEAD_START = struct.Struct("<2sBBBxHQ")
 _HEAD_END = struct.Struct("<QIHH")
 _PLAIN = struct.Struct(f"<{_HEAD_START.size}sI{_HEAD_END.size}sIq")  # start, seq, end, total, stamp
 _time_ns = time.time_ns
-_unpack_header = HEADER.unpack_from
+# the header as the receive path reads it: HEADER with the magic as a number (no bytes object
+# made per datagram)
+_unpack_header = struct.Struct("<H" + HEADER.format[3:]).unpack_from
 _new_tuple = tuple.__new__  # builds a Delivery without its Python-level __new__ (per message)
 _MAGIC = hdr.MAGIC
+_MAGIC_LE = int.from_bytes(_MAGIC, "little")
 _ADDRESSED = int(Flags.ADDRESSED)  # plain ints: enum operators are slow per datagram
 _BATCH = int(Flags.BATCH)
 _SIGNED = int(Flags.SIGNED)
 _SHM = int(Flags.SHM)
+_UNCOMMON = _BATCH | _ADDRESSED | _SHM  # what the receive path's common case never carries
 _DATA = int(Kind.DATA)
 _VERSION = hdr.VERSION
 
@@ -523,7 +527,8 @@ class Reader:
             True when the source may hold more (the limit was reached).
         """
         wanted, want_all, ignored = self.wanted, self.want_all, self.ignored
-        clock, streams, auth = time.time_ns, self.streams, self.auth
+        clock, streams, append = time.time_ns, self.streams, out.append
+        verify = None if self.auth is None else self.auth.verify
         copied = 0  # bytes copied out of shared memory by this call
         if self.shm is not None:
             self.shm.rewind()
@@ -544,103 +549,151 @@ class Reader:
                 continue
             (magic, version, kind, flags, count, sender, seq, topic, type_, index,
              endpoint, total, stamp) = _unpack_header(data)  # fmt: skip
-            if magic != _MAGIC or version != _VERSION or count == 0 or index >= count:
+            if magic != _MAGIC_LE or version != _VERSION or index >= count:  # (count 0 too)
                 self.foreign += 1
                 continue
-            if (not want_all and topic not in wanted) or topic in ignored:
+            if (topic not in wanted and not want_all) or (ignored and topic in ignored):
                 self.unwanted += 1  # read no further (and spend no MAC on it)
                 continue
             if flags & _SIGNED:
                 size -= MAC_SIZE
                 flags ^= _SIGNED  # a wire detail: deliveries carry the message's flags
-                if auth is not None and not auth.verify(data):
+                if verify is not None and not verify(data):
                     self.forged += 1
                     continue
-            elif auth is not None:
+            elif verify is not None:
                 self.unsigned += 1
                 continue
             if not -FRESH_NS <= now - stamp <= FRESH_NS:
                 self.stale += 1  # captured long ago, or a clock far off: never delivered
                 continue
-            if flags & _BATCH:
-                self._unbatch(data, size, kind, flags, sender, endpoint, topic, type_, total,
-                              stamp, now, out)  # fmt: skip
+            if kind != _DATA or count != 1 or flags & _UNCOMMON:
+                copied += self._accept(data, size, kind, flags, count, sender, seq, topic,
+                                       type_, index, endpoint, total, stamp, now, out)  # fmt: skip
+                if copied >= SHM_DRAIN_BYTES:
+                    return True  # the rest stays in the socket: copies are freed before more
                 continue
-            stats = None
-            if kind == _DATA:
-                stats = streams.get((sender, endpoint))
+            # the common case, a whole message on a topic (what _accept does for it, with the
+            # window's usual step inline)
+            stats = streams.get((sender, endpoint))
+            if stats is None:
+                stats = self._open(streams, (sender, endpoint), topic, seq, stamp, now)
                 if stats is None:
-                    stats = self._open(streams, (sender, endpoint), topic, seq, stamp, now)
-                    if stats is None:
-                        continue
-                elif count > 1 and _seen(stats, seq):
-                    self.duplicates += 1  # a fragment of a message delivered already
                     continue
-            if count == 1:
-                if total != size - HEADER_SIZE:
-                    self.reassembler.malformed += 1
-                    continue
-                payload: memoryview | bytearray | mmap.mmap = memoryview(data)[HEADER_SIZE:size]
-            else:
-                whole = self.reassembler.add(
-                    hdr.Header(_MAGIC, version, kind, flags, count, sender, seq, topic, type_,
-                               index, endpoint, total, stamp),
-                    memoryview(data)[HEADER_SIZE:size],
-                    now,
-                )  # fmt: skip
-                if whole is None:
-                    continue
-                payload = whole
-            address = None
-            if flags & _ADDRESSED:
-                if len(payload) < ADDRESS_SIZE:
-                    self.reassembler.malformed += 1
-                    continue
-                address = ADDRESS.unpack_from(payload)
-                payload = memoryview(payload)[ADDRESS_SIZE:]
-            if stats is None:  # requests, responses, replays, discovery: no loss counted
-                key = (sender, endpoint, kind, *(address or (0, 0))[:2])
-                stats = self.others.get(key)
-                if stats is None:
-                    stats = self._open(self.others, key, topic, seq, stamp, now)
-                    if stats is None:
-                        continue
-                verdict = place_in_window(stats, seq, stamp, now, False)
+            if total != size - HEADER_SIZE:
+                self.reassembler.malformed += 1
+                continue
+            if (seq - stats.last_seq) & _MASK32 == 1 and not stats.pending:
+                seen = stats.seen  # (place_in_window's next-in-line case, nothing lost)
+                if seen != _FULL:
+                    stats.seen = ((seen << 1) | 1) & _FULL
+                stats.last_seq = seq
+                stats.run += 1
+                if stamp > stats.stamp:
+                    stats.stamp = min(stamp, now + BORN_SLACK_NS)
+                stats.received += 1
+                stats.last_received = now
             else:
                 verdict = place_in_window(stats, seq, stamp, now, True)
-            if verdict:
-                if verdict > 0:
-                    self._refuse(verdict)
-                    continue
-                if kind == _DATA:  # a server's replies to one client skip numbers by design
+                if verdict:
+                    if verdict > 0:
+                        self._refuse(verdict)
+                        continue
                     self._jumped(sender, endpoint, stats)
-            if flags & _SHM:
-                resolved = self._from_shm(sender, endpoint, payload, stats)
-                if resolved is None:
-                    continue
-                payload, flags = resolved, flags ^ _SHM
-                copied += len(resolved)
-            out.append(
+            append(
                 _new_tuple(
                     Delivery,
-                    (
-                        kind,
-                        sender,
-                        endpoint,
-                        seq,
-                        topic,
-                        type_,
-                        stamp,
-                        now,
-                        payload,
-                        address,
-                        flags,
-                    ),
+                    (kind, sender, endpoint, seq, topic, type_, stamp, now,
+                     memoryview(data)[HEADER_SIZE:size], None, flags),
                 )
-            )
-            if copied >= SHM_DRAIN_BYTES:
-                return True  # the rest stays in the socket: copies are freed before more
+            )  # fmt: skip
         return True
+
+    def _accept(
+        self,
+        data: bytes,
+        size: int,
+        kind: int,
+        flags: int,
+        count: int,
+        sender: int,
+        seq: int,
+        topic: int,
+        type_: int,
+        index: int,
+        endpoint: int,
+        total: int,
+        stamp: int,
+        now: int,
+        out: list[Delivery],
+    ) -> int:
+        """Take one checked datagram that is not a plain whole message (see :meth:`drain`).
+
+        Batches, fragments, addressed and shared-memory messages, and every kind but
+        ``DATA``. Returns the bytes it copied out of shared memory.
+        """
+        if flags & _BATCH:
+            self._unbatch(data, size, kind, flags, sender, endpoint, topic, type_, total,
+                          stamp, now, out)  # fmt: skip
+            return 0
+        stats = None
+        if kind == _DATA:
+            stats = self.streams.get((sender, endpoint))
+            if stats is None:
+                stats = self._open(self.streams, (sender, endpoint), topic, seq, stamp, now)
+                if stats is None:
+                    return 0
+            elif count > 1 and _seen(stats, seq):
+                self.duplicates += 1  # a fragment of a message delivered already
+                return 0
+        if count == 1:
+            if total != size - HEADER_SIZE:
+                self.reassembler.malformed += 1
+                return 0
+            payload: memoryview | bytearray | mmap.mmap = memoryview(data)[HEADER_SIZE:size]
+        else:
+            whole = self.reassembler.add(
+                hdr.Header(_MAGIC, _VERSION, kind, flags, count, sender, seq, topic, type_,
+                           index, endpoint, total, stamp),
+                memoryview(data)[HEADER_SIZE:size],
+                now,
+            )  # fmt: skip
+            if whole is None:
+                return 0
+            payload = whole
+        address = None
+        if flags & _ADDRESSED:
+            if len(payload) < ADDRESS_SIZE:
+                self.reassembler.malformed += 1
+                return 0
+            address = ADDRESS.unpack_from(payload)
+            payload = memoryview(payload)[ADDRESS_SIZE:]
+        if stats is None:  # requests, responses, replays, discovery: no loss counted
+            key = (sender, endpoint, kind, *(address or (0, 0))[:2])
+            stats = self.others.get(key)
+            if stats is None:
+                stats = self._open(self.others, key, topic, seq, stamp, now)
+                if stats is None:
+                    return 0
+            verdict = place_in_window(stats, seq, stamp, now, False)
+        else:
+            verdict = place_in_window(stats, seq, stamp, now, True)
+        if verdict:
+            if verdict > 0:
+                self._refuse(verdict)
+                return 0
+            if kind == _DATA:  # a server's replies to one client skip numbers by design
+                self._jumped(sender, endpoint, stats)
+        copied = 0
+        if flags & _SHM:
+            resolved = self._from_shm(sender, endpoint, payload, stats)
+            if resolved is None:
+                return 0
+            payload, flags = resolved, flags ^ _SHM
+            copied = len(resolved)
+        fields = (kind, sender, endpoint, seq, topic, type_, stamp, now, payload, address, flags)
+        out.append(_new_tuple(Delivery, fields))
+        return copied
 
     def _unbatch(
         self,

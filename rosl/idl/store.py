@@ -30,6 +30,7 @@ if TYPE_CHECKING:
     from rosl.idl.messages import Message
     from rosl.idl.parser import MessageSpec
 
+_DECODE_ERRORS = (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError)
 _SERIALIZE_ERRORS = (
     struct.error,
     TypeError,
@@ -204,8 +205,33 @@ class Store:
             else:
                 view = memoryview(bytearray(data))
             return cast("Message", self._typestore.deserialize_cdr(cast("bytes", view), type_name))
-        except (SerdeError, struct.error, ValueError, IndexError, UnicodeDecodeError) as err:
+        except _DECODE_ERRORS as err:
             raise InterfaceError(f"cannot decode {type_name} ({len(data)} bytes): {err}") from err
+
+    def decoder(self, type_name: str) -> Callable[[Any], Message]:
+        """:meth:`deserialize` for one registered type, made for a subscription's messages.
+
+        The common case — a read-only view of a little-endian CDR message, as the bus
+        delivers — goes straight to the type's generated function, with the checks rosbags
+        makes around it; anything else, and every failure, takes :meth:`deserialize`, so the
+        result and the errors are its own.
+        """
+        typestore, slow = self._typestore, self.deserialize
+        msgdef: Any = typestore.get_msgdef(type_name)  # (its functions are made on first use)
+        cls = msgdef.cls
+
+        def decode(data: Any) -> Any:
+            if type(data) is memoryview and data.readonly:
+                try:
+                    if data[0] == 0 and data[1] == 1:  # CDR, little endian
+                        message, end = msgdef.deserialize_cdr_le(data[4:], 0, cls, typestore)
+                        if end + 7 >= len(data):  # (as rosbags: at most 3 bytes of padding)
+                            return message
+                except _DECODE_ERRORS:
+                    pass  # (the same call again raises the error)
+            return slow(data, type_name)
+
+        return decode
 
     def deserialize_with_schema(
         self,

@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import threading
 import weakref
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from rosl.node.task import current_task
@@ -101,8 +102,9 @@ _held = threading.local()  # .groups: the groups of the callbacks running on thi
 
 def held_groups() -> list[CallbackGroup]:
     """This thread's stack of the groups its running callbacks hold (push, run, pop)."""
-    groups: list[CallbackGroup] | None = getattr(_held, "groups", None)
-    if groups is None:
+    try:
+        groups: list[CallbackGroup] = _held.groups  # (per callback: no getattr with a default)
+    except AttributeError:
         groups = _held.groups = []
     return groups
 
@@ -164,6 +166,15 @@ class Queued(Executable):
 
     def _ready(self) -> bool:
         return bool(self._queue)
+
+    def _queue_in(self, queue: deque[Delivery]) -> None:
+        """Make ``queue`` the entity's queue.
+
+        Its ``_ready`` then calls ``bool`` on it with no Python frame in between (a C call):
+        an executor asks every entity of its nodes at every look.
+        """
+        self._queue = queue
+        self._ready = partial(bool, queue)  # type: ignore[method-assign]
 
     @property
     def queue_limit(self) -> int | None:

@@ -69,7 +69,7 @@ class Client(Queued):
         )  # fmt: skip
         self._store = registry.store()
         self._pending: dict[int, Future[Any]] = {}
-        self._queue: deque[Delivery] = deque()
+        self._queue_in(deque())
         self._lock = threading.Lock()  # a response may be taken on another thread at once
         self._what = name
         self.destroyed = False

@@ -13,10 +13,12 @@ import itertools
 import os
 import threading
 import time
+from operator import itemgetter
 from typing import TYPE_CHECKING, Protocol, cast
 
 from rosl.bus.header import topic_hash
 from rosl.bus.transport import CHANNELS, channel_of, open_transport
+from rosl.bus.wire import Delivery
 from rosl.graph.announce import Discovery
 from rosl.node.callback_groups import Queued
 
@@ -24,17 +26,23 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from rosl.bus.coalesce import Flusher
-    from rosl.bus.wire import Delivery, Writer
+    from rosl.bus.wire import Writer
     from rosl.graph.cache import GraphCache
     from rosl.graph.records import NodeRecord
     from rosl.node.lockstep import Answerer
 
 
 MAX_ASSERTING = 4096  # publishers whose manual liveliness assertions are remembered
+_TOPIC_OF = itemgetter(Delivery._fields.index("topic"))  # (read in C, per message)
 
 
 class Handler(Protocol):
-    """Something that takes deliveries for one topic or service hash."""
+    """Something that takes deliveries for one topic or service hash.
+
+    One that also has ``deliver_all(deliveries)`` is given a poll's deliveries of its topic
+    at once, in order, when they are all of that topic (many publishers into one topic);
+    it must do what ``deliver`` of each would.
+    """
 
     def deliver(self, delivery: Delivery) -> None:
         """Handle one complete message."""
@@ -63,6 +71,8 @@ class Participant:
         self._node_ids = itertools.count(1)
         self._describers: dict[int, Callable[[], NodeRecord]] = {}
         self._handlers: dict[int, list[Handler]] = {}
+        # per topic, what takes a poll's deliveries of it at once (rebuilt from _handlers)
+        self._takers: dict[int, tuple[Callable[[list[Delivery]], None], ...]] = {}
         self._limits: dict[int, int] = {}  # channel -> datagrams one poll reads (see listen)
         self._lock = threading.RLock()
         # executors waiting for work; reentrant: a signal handler may notify() while the
@@ -165,6 +175,7 @@ class Participant:
             self._handlers.setdefault(topic, []).append(handler)
             self.reader.wanted.add(topic)
             self._limit_reads()
+            self._retake()
         self._receiver.join(channel_of(topic))
         self.notify()
 
@@ -179,6 +190,12 @@ class Participant:
                 if not self.reader.want_all:
                     self.reader.wanted.discard(topic)
             self._limit_reads()
+            self._retake()
+
+    def _retake(self) -> None:
+        """Rebuild what takes a topic's deliveries at once (under ``_lock``)."""
+        self._takers = {topic: tuple(map(_taker, handlers))
+                        for topic, handlers in self._handlers.items()}  # fmt: skip
 
     def _limit_reads(self) -> None:
         """Per channel, the shallowest queue its messages go to: what one poll should read.
@@ -343,11 +360,19 @@ class Participant:
         channels = self._receiver.poll(timeout, deliveries, None, limits)
         if channels > 1:
             deliveries.sort(key=_send_order)  # in the order they were sent, across channels
-        for delivery in deliveries:
-            if sink is not None:
+        if sink is not None:
+            for delivery in deliveries:
                 sink(delivery)
+        elif deliveries:
+            topics = list(map(_TOPIC_OF, deliveries))
+            if topics.count(topics[0]) == len(topics):  # one topic (fan-in): all at once
+                for take in self._takers.get(topics[0], ()):
+                    take(deliveries)
             else:
-                self.dispatch(delivery)
+                handlers = self._handlers  # (dispatch, one call less per message)
+                for delivery in deliveries:
+                    for handler in handlers.get(delivery.topic, ()):
+                        handler.deliver(delivery)
         if deliveries:
             self.changes += 1  # queues filled: waiters look again
         return len(deliveries)
@@ -399,6 +424,20 @@ class Participant:
 
 def _send_order(delivery: Delivery) -> int:
     return delivery.stamp
+
+
+def _taker(handler: Handler) -> Callable[[list[Delivery]], None]:
+    """What hands a handler a poll's deliveries of its topic: its ``deliver_all``, or each."""
+    deliver_all: Callable[[list[Delivery]], None] | None = getattr(handler, "deliver_all", None)
+    if deliver_all is not None:
+        return deliver_all
+    deliver = handler.deliver
+
+    def each(deliveries: list[Delivery]) -> None:
+        for delivery in deliveries:
+            deliver(delivery)
+
+    return each
 
 
 def _never() -> bool:

@@ -79,7 +79,7 @@ class Service(Queued):
         self._store = registry.store()
         self.handled = 0
         self.destroyed = False
-        self._queue: deque[Delivery] = deque(maxlen=REQUESTS_KEPT)
+        self._queue_in(deque(maxlen=REQUESTS_KEPT))
         self._what = name
         participant.listen(self._topic, self)
 

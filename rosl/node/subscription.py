@@ -12,14 +12,16 @@ taking two arguments also get the message info (timestamps, sequence).
 
 from __future__ import annotations
 
-import functools
 import inspect
 import time
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import partial
+from operator import itemgetter
 from typing import TYPE_CHECKING, Any
 
 from rosl.bus.header import Flags, Kind, topic_hash, type_hash
+from rosl.bus.wire import Delivery
 from rosl.graph.records import LOST_FROM, PUBLISHER, SUBSCRIPTION, EndpointRecord, gid
 from rosl.idl import registry
 from rosl.idl.errors import InterfaceError
@@ -30,13 +32,14 @@ from rosl.node.qos_compatibility import compatible
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-    from rosl.bus.wire import Delivery
     from rosl.idl.messages import Message
     from rosl.node.node import Node
     from rosl.node.qos import QoSProfile
 
 
 _REPLAY, _DATA = int(Kind.REPLAY), int(Kind.DATA)  # plain ints compare faster than enums
+_monotonic_ns = time.monotonic_ns
+_KIND_OF = itemgetter(Delivery._fields.index("kind"))  # (read in C, per message)
 _LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
 KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
@@ -75,6 +78,10 @@ class _Peer:
     generation: int  # the graph's generation when that was decided
     takes: bool = True  # its QoS matches this subscription's (see qos_compatibility)
     lifespan_ns: int = 0  # its messages are not delivered once older than this (0: never)
+    plain: bool = field(init=False)  # its messages are all taken, with no check (the usual)
+
+    def __post_init__(self) -> None:
+        self.plain = self.agrees is True and self.takes and not self.lifespan_ns
 
 
 class Subscription(Queued):
@@ -103,6 +110,7 @@ class Subscription(Queued):
         self._type_hash = type_hash(self.type_name)
         self._with_info = _wants_info(callback)
         self._store = registry.store()
+        self._decode: Callable[[Any], Any] = self._first_decode  # (the type's decoder, made then)
         self.digest = registry.digest(self.type_name)
         self._peers: dict[tuple[int, int], _Peer] = {}  # by (process, endpoint)
         self._graph = participant.graph
@@ -111,7 +119,9 @@ class Subscription(Queued):
         self.log_loss = True  # False for tools that report loss in their own words (echo)
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
-        self._queue: deque[Delivery] = deque(maxlen=queue_depth(qos))
+        self._depth = queue_depth(qos)
+        self._queue_in(deque(maxlen=self._depth))
+        self._keeps_history = qos.keeps_history
         self._what = topic
         self.received = 0
         self.dropped = 0  # deliveries pushed out of a full queue (the callback fell behind)
@@ -148,19 +158,36 @@ class Subscription(Queued):
         if self.destroyed:
             return
         kind = delivery.kind
-        if kind == _REPLAY:
+        if kind != _DATA:
+            if kind != _REPLAY:
+                return
             address = delivery.address
             if address is None or address[0] != self._sender or address[1] != self.endpoint:
                 return  # history asked for by another subscription
-        elif kind != _DATA:
-            return
-        now = self.last_arrival_ns = time.monotonic_ns()
+        now = self.last_arrival_ns = _monotonic_ns()
         if self.peer_seen is not None:
             self._seen(delivery, now)
         queue = self._queue
         if len(queue) == queue.maxlen:
             self.dropped += 1
         queue.append(delivery)
+
+    def deliver_all(self, deliveries: list[Delivery]) -> None:
+        """Queue a poll's deliveries for this topic at once: what :meth:`deliver` of each does."""
+        count = len(deliveries)
+        if self.destroyed or list(map(_KIND_OF, deliveries)).count(_DATA) != count:
+            for delivery in deliveries:  # (replays, or nothing: one at a time)
+                self.deliver(delivery)
+            return
+        now = self.last_arrival_ns = _monotonic_ns()
+        if self.peer_seen is not None:
+            for delivery in deliveries:
+                self._seen(delivery, now)
+        queue = self._queue
+        pushed_out = len(queue) + count - self._depth  # (the oldest go, new ones too if many)
+        if pushed_out > 0:
+            self.dropped += pushed_out
+        queue.extend(deliveries)
 
     def _seen(self, delivery: Delivery, now_ns: int) -> None:
         seen = self.peer_seen
@@ -208,49 +235,40 @@ class Subscription(Queued):
 
     def _take(self) -> Callable[[], Any] | None:
         """Take the oldest queued delivery: the call of the callback with its message."""
-        delivery = self._pop()
-        if delivery is None:
-            return None
-        if delivery.flags & _LOCKSTEP:
+        try:
+            delivery = self._queue.popleft()
+        except IndexError:
+            return None  # another thread took it
+        kind, sender, endpoint, seq, _, type_, stamp, received, payload, _, flags = delivery
+        if flags & _LOCKSTEP:
             answerer = self.node.participant.answerer
             if answerer is not None:
                 answerer.handled(delivery)
         if self.destroyed:
             return None
-        if delivery.kind == _REPLAY:
-            replayed = (delivery.sender, delivery.endpoint, delivery.seq)
+        if kind == _REPLAY:
+            replayed = (sender, endpoint, seq)
             if replayed in self._replayed:
                 return None
             self._replayed.append(replayed)
-        if delivery.type != self._type_hash:
+        if type_ != self._type_hash:
             self._mismatch(delivery)
             return None
-        key = (delivery.sender, delivery.endpoint)
+        key = (sender, endpoint)
         peer = self._peers.get(key)
-        if peer is None or (peer.agrees is None and peer.generation != self._graph.generation):
-            if len(self._peers) >= MAX_PEERS:
-                self._peers.clear()  # a cache of the graph: strangers' ids must not grow it
-            peer = self._peers[key] = self._meet(delivery)
-        if peer.agrees is False:
-            self.mismatched += 1
+        if (peer is None or not peer.plain) and not self._admits(delivery, key, peer):
             return None
-        if not peer.takes:
-            self.incompatible += 1
-            return None
-        if peer.lifespan_ns and time.time_ns() - delivery.stamp > peer.lifespan_ns:
-            self.expired += 1
-            return None
-        if delivery.kind == _DATA:
-            if self.qos_profile.keeps_history:
-                self._replayed.append((delivery.sender, delivery.endpoint, delivery.seq))
+        if kind == _DATA:
+            if self._keeps_history:
+                self._replayed.append((sender, endpoint, seq))
             stats = self._streams.get(key)
-            if stats is not None and stats.lost and delivery.received >= self._lost_told_at:
+            if stats is not None and stats.lost and received >= self._lost_told_at:
                 self._tell_loss(delivery)
         if self.raw:
-            message: Any = _as_bytes(delivery.payload)
+            message: Any = _as_bytes(payload)
         else:
             try:
-                message = self._store.deserialize(delivery.payload, self.type_name)
+                message = self._decode(payload)
             except InterfaceError as err:
                 self.undecodable += 1
                 if self.undecodable == 1:
@@ -259,14 +277,36 @@ class Subscription(Queued):
         self.received += 1
         if self._with_info:
             info = {
-                "source_timestamp": delivery.stamp,
-                "received_timestamp": delivery.received,
-                "publication_sequence_number": delivery.seq,
+                "source_timestamp": stamp,
+                "received_timestamp": received,
+                "publication_sequence_number": seq,
                 "reception_sequence_number": self.received,
-                "publisher_gid": (delivery.sender, delivery.endpoint),
+                "publisher_gid": (sender, endpoint),
             }
-            return functools.partial(self.callback, message, info)
-        return functools.partial(self.callback, message)
+            return partial(self.callback, message, info)
+        return partial(self.callback, message)
+
+    def _admits(self, delivery: Delivery, key: tuple[int, int], peer: _Peer | None) -> bool:
+        """Whether a message of a publisher that is not plain is taken (counts what is not)."""
+        if peer is None or (peer.agrees is None and peer.generation != self._graph.generation):
+            if len(self._peers) >= MAX_PEERS:
+                self._peers.clear()  # a cache of the graph: strangers' ids must not grow it
+            peer = self._peers[key] = self._meet(delivery)
+        if peer.agrees is False:
+            self.mismatched += 1
+            return False
+        if not peer.takes:
+            self.incompatible += 1
+            return False
+        if peer.lifespan_ns and time.time_ns() - delivery.stamp > peer.lifespan_ns:
+            self.expired += 1
+            return False
+        return True
+
+    def _first_decode(self, payload: Any) -> Any:
+        """Decode the first message: make the type's decoder (see ``Store.decoder``) first."""
+        self._decode = self._store.decoder(self.type_name)
+        return self._decode(payload)
 
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1

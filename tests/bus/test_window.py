@@ -387,3 +387,103 @@ def test_a_forged_jump_stamped_ahead_does_not_hold_the_real_stream_back(bus: Wir
     bus.marker(5)
     assert [s for s in bus.seqs() if s < 100] == [1, 2, 3, 4]
     assert bus.reader.lost() == 0
+
+
+# --- the receive path's common case against the window's rules ----------------------------------
+
+MARK_SENDER = 0xEEEE  # a stream of its own for the markers of the tests below
+CHUNK = 400  # datagrams sent before waiting for the reader (no socket overflows)
+
+
+def _send_in_chunks(bus: Wire, datagrams: list[bytes]) -> None:
+    for start in range(0, len(datagrams), CHUNK):
+        bus.send(*datagrams[start : start + CHUNK])
+        bus.marker(start // CHUNK + 1, sender=MARK_SENDER)
+
+
+def _arrivals(rng: random.Random, senders: list[int], length: int) -> list[tuple[int, int]]:
+    """(sender, seq) in arrival order: mostly in line, with gaps, repeats, late and far ones."""
+    following = dict.fromkeys(senders, 1)
+    heard: dict[int, list[int]] = {s: [] for s in senders}
+    order = []
+    for _ in range(length):
+        sender = rng.choice(senders)
+        roll = rng.random()
+        if roll < 0.10:  # a gap
+            following[sender] += rng.randint(1, 5)
+        elif roll < 0.12:  # a gap longer than the duplicate window
+            following[sender] += wire.DUP_WINDOW + rng.randint(1, 50)
+        if 0.12 <= roll < 0.22 and heard[sender]:  # a repeat, or an old one after a big gap
+            seq = rng.choice(heard[sender][-60:])
+        elif 0.22 <= roll < 0.27 and following[sender] > 20:  # late (maybe never sent before)
+            seq = following[sender] - rng.randint(1, 20)
+        else:
+            seq = following[sender]
+            following[sender] += 1
+        heard[sender].append(seq)
+        order.append((sender, seq))
+    return order
+
+
+def test_the_receive_path_follows_the_window_rules_for_many_streams(bus: Wire) -> None:
+    # the reader takes a plain message that goes on in line without calling place_in_window:
+    # every count must come out as place_in_window, message by message, would make them
+    rng = random.Random(1234)
+    senders = [0x5EED_0000 + i for i in range(20)]
+    order = _arrivals(rng, senders, 3000)
+    base = time.time_ns()
+    stamps = [base + i * 1000 for i in range(len(order))]  # each newer than the one before
+    _send_in_chunks(bus, [
+        bus.datagram(seq, b"m", sender=sender, stamp=stamp)
+        for (sender, seq), stamp in zip(order, stamps, strict=True)
+    ])  # fmt: skip
+    expected: dict[int, wire.StreamStats] = {}
+    delivered, refused = [], {wire.DUPLICATE: 0, wire.STALE: 0}
+    now = time.time_ns()
+    for (sender, seq), stamp in zip(order, stamps, strict=True):
+        stats = expected.get(sender)
+        if stats is None:
+            stats = expected[sender] = wire.StreamStats(TOPIC_HASH, last_seq=seq - 1)
+        verdict = wire.place_in_window(stats, seq, stamp, now, True)
+        if verdict <= 0:
+            delivered.append((sender, seq))
+        else:
+            refused[verdict] += 1
+    got = [(d.sender, d.seq) for d in bus.collector.snapshot() if d.sender in expected]
+    assert got == delivered
+    fields = ("received", "lost", "pending", "last_seq", "seen", "jumps", "run", "stamp", "left")
+    for sender, stats in expected.items():
+        mine = bus.reader.streams[(sender, 1)]
+        assert [getattr(mine, f) for f in fields] == [getattr(stats, f) for f in fields]
+    assert bus.reader.lost(TOPIC_HASH) == sum(s.lost for s in expected.values()) > 0
+    assert bus.reader.duplicates == refused[wire.DUPLICATE] > 0
+    assert bus.reader.stale == refused[wire.STALE]
+    assert any(s.jumps for s in expected.values())  # (the test takes every way through)
+    assert any(s.pending for s in expected.values()) or any(s.left for s in expected.values())
+
+
+def test_loss_from_many_publishers_is_what_was_never_sent(bus: Wire) -> None:
+    rng = random.Random(99)
+    senders = [0xFA11_0000 + i for i in range(20)]
+    kept = {s: [q for q in range(1, 201) if q in (1, 200) or rng.random() > 0.1] for s in senders}
+    queues = {s: list(seqs) for s, seqs in kept.items()}
+    datagrams, repeats = [], 0
+    while queues:  # the publishers interleaved, each in order, some datagrams twice
+        sender = rng.choice(sorted(queues))
+        seq = queues[sender].pop(0)
+        datagrams.append(bus.datagram(seq, sender=sender))
+        if rng.random() < 0.05:
+            datagrams.append(bus.datagram(seq, b"again", sender=sender))
+            repeats += 1
+        if not queues[sender]:
+            del queues[sender]
+    _send_in_chunks(bus, datagrams)
+    never_sent = {s: 200 - len(seqs) for s, seqs in kept.items()}
+    assert bus.reader.lost(TOPIC_HASH) == sum(never_sent.values()) > 0
+    markers = bus.reader.streams[(MARK_SENDER, 1)].received
+    assert bus.reader.received(TOPIC_HASH) - markers == sum(map(len, kept.values()))
+    assert bus.reader.duplicates == repeats
+    by_publisher = {key[0]: lost for key, lost in bus.reader.lost_by_publisher(TOPIC_HASH).items()}
+    assert by_publisher == {s: n for s, n in never_sent.items() if n}
+    got = sorted((d.sender, d.seq) for d in bus.collector.snapshot() if d.sender in kept)
+    assert got == sorted((s, q) for s, seqs in kept.items() for q in seqs)

@@ -173,3 +173,19 @@ def test_loss_is_counted_when_a_slow_subscriber_drops_the_backlog_for_fresh_mess
         assert counted["received"] + counted["lost"] <= counted["span"], report  # none twice
         missing += counted["span"] - counted["received"] - counted["lost"]
     assert missing <= report["dropped"], report  # what is neither came out of the queue
+
+
+def test_messages_pushed_out_of_the_queue_are_counted_exactly(spawn, tmp_path):
+    # the burst waits in the socket; with no backlog bound each poll reads what waits at once
+    # (up to a thousand: more than the 5-deep queue holds), and the subscriber takes a poll's
+    # messages of its topic in one go: every message up to the newest is delivered or counted
+    # as pushed out of the queue, nothing is lost on the way
+    if granted_rcvbuf() < 1 << 20:
+        pytest.skip("the OS grants less than 1 MiB of receive buffer (net.core.rmem_max)")
+    report = fan_in(spawn, tmp_path, count=300, size=32, depth=5, env={"ROSL_BACKLOG_MS": "0"})
+
+    publishers = report["publishers"].values()
+    assert report["lost"] == 0, report
+    assert all(counted["lost"] == 0 and counted["span"] > 300 for counted in publishers), report
+    missing = sum(counted["span"] - counted["received"] for counted in publishers)
+    assert missing == report["dropped"] > 0, report
