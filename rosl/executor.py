@@ -503,6 +503,11 @@ class Executor:
                     return due
                 wait = due
             elif self._collect(chosen, batch):
+                item, node = batch[0]
+                if not isinstance(item, Task):  # this look found it ready and runnable
+                    batch.popleft()
+                    item._executor_event = True  # not offered again until taken
+                    return item, node
                 continue
             else:
                 wait = self._next_timer(chosen)
