@@ -29,6 +29,7 @@ from types import CoroutineType
 from typing import TYPE_CHECKING, Any
 
 from rosl.node.callback_groups import MutuallyExclusiveCallbackGroup, held_groups
+from rosl.node.clock import ClockType
 from rosl.node.task import Future, Task, current_task
 
 if TYPE_CHECKING:
@@ -108,6 +109,14 @@ class Executor:
         # spin_once may take the timers-only way (_spin_timers): callbacks run on this thread
         cls = type(self)
         self._plain = cls._run is Executor._run and cls._next_work is Executor._next_work
+        # the timers-only looks (_due_timer, _spin_timer) do not call can_execute: not for an
+        # executor that decides it itself
+        self._timers_only = cls.can_execute is Executor.can_execute
+        self._plain = self._plain and self._timers_only
+        # a timers-only look handed out a due timer without polling the transport first (no
+        # wait came before it): the next such look polls, so a timer that overruns its period
+        # cannot keep what arrives from being read
+        self._unpolled = False
 
     @property
     def context(self) -> Context:
@@ -264,12 +273,18 @@ class Executor:
             if answerer is None or answerer.seen:
                 return False
         changes, nodes = quiet
+        if len(nodes) == 1 and len(nodes[0].timers) == 1:
+            return self._spin_timer(nodes[0], nodes[0].timers[0], changes, deadline, participant)
         waited = False
         self._looking += 1
         try:
             while True:
                 due = self._due_timer(nodes)
                 if isinstance(due, tuple):
+                    if not self._polled_first(waited, participant, changes):
+                        due[0]._executor_event = False
+                        self._fast = None
+                        return False
                     break
                 if due is None:  # no wall-time timer: the usual look waits without one
                     return False
@@ -292,6 +307,83 @@ class Executor:
             task.entity, task.node = timer, node
             task()
         return not timer._internal  # rosl's housekeeping: spin_once goes on to look for one
+
+    def _spin_timer(
+        self,
+        node: Node,
+        timer: Any,
+        changes: int,
+        deadline: float | None,
+        participant: Participant,
+    ) -> bool:
+        """:meth:`_spin_timers` for one node with one timer (a publisher's): asks it alone.
+
+        The same look as :meth:`_due_timer`'s for a single wall-time timer, with its clock
+        read directly; False (look the usual way) for anything else.
+        """
+        clock = timer.clock
+        group = None if timer._ungrouped else timer.callback_group
+        now_ns = time.monotonic_ns if clock.clock_type is ClockType.STEADY_TIME else time.time_ns
+        waited = False
+        self._looking += 1
+        try:
+            while True:
+                if (
+                    timer._canceled
+                    or timer._executor_event
+                    or clock._sim_ns is not None  # (sim-time timers are woken by /clock)
+                    or (group is not None and not group.can_execute(timer))
+                ):
+                    return False
+                until = timer._next_call_ns - now_ns()
+                if until <= 0:
+                    if not self._polled_first(waited, participant, changes):
+                        return False
+                    break
+                wait = until / 1e9
+                if deadline is not None:
+                    remaining = deadline - time.monotonic()
+                    if remaining <= 0 and waited:
+                        return True
+                    wait = min(wait, max(0.0, remaining))
+                waited = True
+                self._looks += 1
+                if participant.wait_change(wait, changes):
+                    self._quiet = None
+                    return False
+            timer._executor_event = True  # (as _due_timer hands it out)
+            self._fast = timer
+            self._fast_thread = threading.get_ident()
+            self._fast_looks = self._looks
+        finally:
+            self._looking -= 1
+        result = self._execute(timer, node)
+        if isinstance(result, CoroutineType):  # (as _run)
+            task: Task[Any] = Task(_given, (result,), executor=self)
+            task.entity, task.node = timer, node
+            task()
+        return not timer._internal
+
+    def _polled_first(self, waited: bool, participant: Participant, changes: int) -> bool:
+        """Before a timers-only look hands out a due timer: False when a poll found news.
+
+        A look that waited polled the transport. One that did not (the timer was due at once)
+        polls first when the look before it did not either: a timer whose callback outlasts
+        its period is always due, and would otherwise keep every message, request and response
+        in the socket. Costs nothing while the timer keeps its period. When the poll read
+        something, the caller lets the usual look decide (``_quiet`` is then cleared).
+        """
+        if waited:
+            self._unpolled = False
+            return True
+        if not self._unpolled:
+            self._unpolled = True
+            return True
+        self._unpolled = False
+        if participant.wait_change(0.0, changes):
+            self._quiet = None
+            return False
+        return True
 
     def _after_external_shutdown(self) -> None:
         """``spin_once`` after the context was shut down: return once, then end the loop.
@@ -494,13 +586,22 @@ class Executor:
             changes = None if participant is None else participant.changes
             chosen = self._nodes if only is None else only
             quiet = self._quiet
-            if quiet is not None and changes == quiet[0] and chosen is quiet[1]:
+            if (
+                quiet is not None
+                and changes == quiet[0]
+                and chosen is quiet[1]
+                and self._timers_only
+            ):
                 # the wait timed out with nothing changed: only time moved (all else that
                 # becomes ready or runnable says so through participant.notify()), so the
                 # first due timer is the one to run; the next call looks at the rest
                 due = self._due_timer(chosen)
                 if isinstance(due, tuple):
-                    return due
+                    if participant is None or self._polled_first(waited, participant, changes):
+                        return due
+                    due[0]._executor_event = False  # something arrived: look at it all
+                    self._fast = None
+                    continue
                 wait = due
             elif self._collect(chosen, batch):
                 item, node = batch[0]

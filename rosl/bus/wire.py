@@ -272,6 +272,8 @@ class Writer:
 
     @flags.setter
     def flags(self, value: int) -> None:
+        if self.batch is not None:  # what it holds goes first, as send() does it
+            self.batch.flush()
         self._flags = int(value)
         self._choose()
 

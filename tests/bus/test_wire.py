@@ -211,6 +211,22 @@ def test_send_plain_follows_the_writers_flags_as_they_change(bus: Bus) -> None:
     assert bytes(got[2].payload) == payload_of(CHUNK * 2)
 
 
+def test_messages_a_batch_holds_go_before_a_send_with_changed_flags(bus: Bus) -> None:
+    # lock-step marks a writer that may already be coalescing: what its batch holds is sent
+    # first, in order (else the reader takes the batch, sent later, for old duplicates)
+    from rosl.node.publisher import _HeldByCaller
+
+    bus.writer.coalesce(_HeldByCaller(), 8192)
+    bus.writer.send_plain(b"a")
+    bus.writer.send_plain(b"b")
+    bus.writer.flags |= Flags.LOCKSTEP
+    bus.writer.send_plain(b"c")
+    bus.writer.flush()
+    got = bus.collector.wait_count(3, timeout=5.0)
+    assert [bytes(d.payload) for d in got] == [b"a", b"b", b"c"]
+    assert bus.reader.duplicates == 0
+
+
 # --- loss counting ----------------------------------------------------------------------------
 
 

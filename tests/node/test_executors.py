@@ -14,7 +14,7 @@ import json
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import pytest
 
@@ -1368,3 +1368,72 @@ def test_spin_once_with_only_a_distant_timer_returns_at_its_timeout_having_run_n
     assert executor._quiet is not None
     executor.spin_once(timeout_sec=0)
     assert ticks == []
+
+
+def test_spin_once_of_a_node_with_one_steady_clock_timer_ticks_and_stops_when_canceled(ros):
+    from rosl.node.clock import Clock, ClockType
+
+    node, executor = settled(ros, "one_steady_timer")
+    ticks: list[int] = []
+    timer = node.create_timer(
+        0.002, lambda: ticks.append(1), clock=Clock(clock_type=ClockType.STEADY_TIME)
+    )
+    assert spin_until(executor, lambda: len(ticks) >= 20)
+    assert executor._quiet is not None  # (the one-timer way was taken)
+    timer.cancel()
+    stopped_at = len(ticks)
+    for _ in range(5):
+        executor.spin_once(timeout_sec=0.01)  # returns at its timeout with nothing to run
+    assert len(ticks) == stopped_at
+    timer.reset()
+    assert spin_until(executor, lambda: len(ticks) >= stopped_at + 10)
+
+
+def test_a_timer_that_outlasts_its_period_does_not_keep_messages_from_being_read(ros):
+    # always due (its callback takes longer than its period), so no wait comes between its
+    # calls: the timers-only look still polls, and its node's subscription gets every message
+    from rosl.idl.registry import get_message_class
+
+    node, executor = settled(ros, "overrun")
+    String = get_message_class("std_msgs/msg/String")
+    heard: list[str] = []
+    node.create_subscription(String, "/overrun", lambda m: heard.append(m.data), 100)
+    talker = ros.Node("overrun_talker").create_publisher(String, "/overrun", 100)
+    ticks: list[int] = []
+
+    def tick() -> None:
+        ticks.append(1)
+        time.sleep(0.003)
+
+    timer = node.create_timer(0.05, tick)
+    assert spin_until(executor, lambda: len(ticks) >= 3)
+    assert executor._quiet is not None  # (the timers-only look is the one under test)
+    timer.timer_period_ns = 1_000_000
+    assert spin_until(executor, lambda: len(ticks) >= 10)
+    for i in range(3):
+        talker.publish(String(data=f"m{i}"))
+    assert spin_until(executor, lambda: len(heard) == 3), heard
+    assert heard == ["m0", "m1", "m2"]
+
+
+def test_an_executor_that_decides_can_execute_itself_is_asked_for_timers_too(ros):
+    class Picky(SingleThreadedExecutor):
+        refused: ClassVar[set[Any]] = set()
+
+        def can_execute(self, entity: Any) -> bool:
+            return entity not in self.refused and super().can_execute(entity)
+
+    node = ros.Node("picky")
+    startup = list(node.timers)
+    executor = Picky()
+    executor.add_node(node)
+    settle(executor, node, startup)
+    refused: list[int] = []
+    allowed: list[int] = []
+    first = node.create_timer(0.01, lambda: refused.append(1))
+    node.create_timer(0.013, lambda: allowed.append(1))
+    assert spin_until(executor, lambda: len(refused) >= 5)
+    Picky.refused.add(first)
+    before = len(refused)
+    assert spin_until(executor, lambda: len(allowed) >= 30)
+    assert len(refused) == before
