@@ -20,8 +20,10 @@ them only when they are regular files of their own user that nobody else can rea
 
 A ring starts at about :data:`RING_BYTES`, its slots the first message's size and an eighth
 more; a message that outgrows them gets a new ring of bigger slots, and a publisher that goes
-round its ring in less than :data:`LAP_S` one twice as deep (up to :data:`RING_MAX_BYTES`), so
-a subscriber stalled by a loaded machine still finds its messages.
+round its ring in less than :data:`LAP_S` one twice as deep (up to :data:`RING_MAX_BYTES`, and
+only while a quarter of the directory stays free for others' rings), so a subscriber stalled
+by a loaded machine still finds its messages. A forked child leaves its parent's rings to the
+parent and makes its own.
 
 Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
 transport closes (and at interpreter exit); one replaced by a bigger ring, or whose publisher
@@ -50,7 +52,7 @@ from typing import TYPE_CHECKING
 
 from rosl.bus.errors import BusError
 from rosl.bus.shm_ring import MAX_SLOTS as RING_MAX_SLOTS
-from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner
+from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner, segment_size
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -229,6 +231,7 @@ class SharedMemory:
         self._finalizer = weakref.finalize(
             self, _close_rings, self._rings, self._retired, os.getpid()
         )
+        _OPEN.add(self)
 
     def path(self, sender: int, endpoint: int, pid: int, incarnation: int) -> str:
         """Where the ring of one endpoint (of one process start) is."""
@@ -295,6 +298,9 @@ class SharedMemory:
         slots = min(ring.slots * 2, RING_MAX_SLOTS, RING_MAX_BYTES // ring.capacity)
         if now - started >= self.lap_s or slots <= ring.slots or key in self._no_room:
             return
+        if not self._room_for(segment_size(slots, ring.capacity)):
+            self._no_room.add(key)  # a deeper ring would crowd out others' first rings
+            return
         incarnation = ring.incarnation + 1
         path = self.path(*key, self._owner.pid, incarnation)
         try:
@@ -308,6 +314,34 @@ class SharedMemory:
             return
         self._retire(ring)
         self._rings[key] = bigger
+
+    def _room_for(self, size: int) -> bool:
+        """Whether ``size`` more bytes leave room in the directory: a quarter, and a ring."""
+        try:
+            info = os.statvfs(self.directory)
+        except OSError:
+            return False
+        left = info.f_bavail * info.f_frsize - size
+        return left >= max(RING_BYTES, info.f_blocks * info.f_frsize // 4)
+
+    def _forked(self) -> None:
+        """In a child forked from this process: the parent's rings are the parent's.
+
+        They are unmapped here and never unlinked by the child, which writes rings of its own
+        (named after its pid) from its first large message on.
+        """
+        self._lock = threading.Lock()  # (another thread may have held it at the fork)
+        self._finalizer.detach()
+        for ring in [*self._rings.values(), *(ring for _, ring in self._retired)]:
+            ring.close(unlink=False)
+        self._rings.clear()
+        self._retired.clear()
+        self._lap_started.clear()
+        self._no_room.clear()
+        self._owner = this_process()
+        self._finalizer = weakref.finalize(
+            self, _close_rings, self._rings, self._retired, os.getpid()
+        )
 
     def _make(self, path: str, incarnation: int, slots: int, capacity: int) -> RingWriter:
         """A new ring; with fewer slots (less slack) where /dev/shm is small (a container's)."""
@@ -361,6 +395,17 @@ class SharedMemory:
         """Unlink every ring this transport made (idempotent)."""
         with self._lock:
             self._finalizer()
+
+
+_OPEN: weakref.WeakSet[SharedMemory] = weakref.WeakSet()  # this process's, for _after_fork
+
+
+def _after_fork() -> None:
+    for shm in list(_OPEN):
+        shm._forked()
+
+
+os.register_at_fork(after_in_child=_after_fork)
 
 
 def _close_rings(

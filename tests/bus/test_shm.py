@@ -306,10 +306,17 @@ writer.use_shm(lambda: True)
 writer.send(bytes(100_000))
 path = transport.shm.path(0x5151, 7, os.getpid(), 1)
 child = os.fork()
-if child == 0:
+if child == 0:  # it writes a ring of its own, and leaves its parent's alone
+    writer.send(bytes(100_000))
+    mine = transport.shm.path(0x5151, 7, os.getpid(), 1)
+    print("child", os.path.exists(mine), flush=True)
+    transport.close()
+    print("child closed", os.path.exists(mine), flush=True)
     sys.exit(0)  # the child's interpreter exits normally: finalizers and atexit run
 os.waitpid(child, 0)
 print("after fork", os.path.exists(path), flush=True)
+writer.send(bytes(100_000))  # the parent's ring is still its own to write
+print("parent", os.path.exists(path), transport.shm._failed, flush=True)
 transport.close()
 print("after close", os.path.exists(path), flush=True)
 """
@@ -318,7 +325,10 @@ print("after close", os.path.exists(path), flush=True)
 def test_a_forked_child_leaves_its_parents_rings(processes: Processes, domain_id: int) -> None:
     child = processes.python(FORKED_CHILD, str(domain_id))
     out = Lines(child.stdout)
+    assert out.wait_line("child ", 30.0) == "child True", Lines(child.stderr).rest(2.0)
+    assert out.wait_line("child closed", 30.0) == "child closed False"
     assert out.wait_line("after fork", 30.0) == "after fork True", Lines(child.stderr).rest(2.0)
+    assert out.wait_line("parent", 30.0) == "parent True False"
     assert out.wait_line("after close", 30.0) == "after close False"
 
 
@@ -472,3 +482,36 @@ def test_a_publisher_that_goes_round_its_ring_quickly_gets_a_deeper_one(tmp_path
     finally:
         shm.close()
     assert list(rings.iterdir()) == []
+
+
+SMALL_DEV_SHM = r"""
+import os, sys
+from rosl.bus.shm import SharedMemory
+
+folder = sys.argv[1]
+first = SharedMemory(domain=0, directory=folder, lap_s=1e9)  # every lap is a quick one
+for i in range(130):  # 1 MiB messages: 56 slots (63 MiB), then twice as many would be asked
+    assert first.put(1, 1, bytes(1024 * 1024)) is not None
+print("first", first._rings[(1, 1)].slots, (1, 1) in first._no_room, flush=True)
+second = SharedMemory(domain=0, directory=folder)  # another publisher's first ring still fits
+print("second", second.put(2, 1, bytes(1024 * 1024)) is not None, second._failed, flush=True)
+"""
+
+
+@pytest.mark.skipif(
+    os.geteuid() != 0 or shutil.which("unshare") is None, reason="needs root and unshare"
+)
+def test_a_ring_is_not_deepened_into_the_last_quarter_of_a_small_dev_shm(
+    processes: Processes, tmp_path: Path
+) -> None:
+    # 200 MiB: the first ring (63 MiB) and one twice as deep (126 MiB) would leave 11 MiB,
+    # too little for another publisher's first ring: the ring stays as it is
+    folder = tmp_path / "shm"
+    folder.mkdir()
+    private = f'mount -t tmpfs -o size=200m tmpfs {folder} && exec "$@"'
+    prefix = ["unshare", "--mount", "--propagation", "private", "sh", "-c", private, "sh"]
+    child = processes.start([*prefix, sys.executable, "-c", SMALL_DEV_SHM, str(folder)])
+    out = Lines(child.stdout)
+    assert out.wait_line("first", 60.0) == "first 56 True", Lines(child.stderr).rest(2.0)
+    assert out.wait_line("second", 30.0) == "second True False"
+    assert wait_exit(child, 30.0) == 0
