@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import array as py_array
 import keyword
+import math
 import operator
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
@@ -36,6 +37,8 @@ if TYPE_CHECKING:
     from rosl.idl.parser import MessageSpec
 else:
     from rosl.idl.lazy_numpy import np  # loaded by the first numeric array
+
+_FLOAT32_MAX = 3.4028234663852886e38  # the largest finite float32
 
 __all__ = [
     "ActionType",
@@ -520,7 +523,13 @@ def convert_scalar(ftype: FieldType, value: Any, where: str) -> Any:
             isinstance(value, (int, float)) or is_numpy(value, "number")
         ):
             raise FieldError(f"{where}: expects a {base} number, got {_show(value)}")
-        return float(value)
+        try:
+            number = float(value)
+        except OverflowError:  # an int beyond any float
+            raise FieldError(f"{where}: {_show(value)} is out of range for {base}") from None
+        if base == "float32" and math.isfinite(number) and abs(number) > _FLOAT32_MAX:
+            raise FieldError(f"{where}: {_show(value)} is out of range for {base}")
+        return number  # (inf and nan are kept, as rclpy keeps them)
     if base == "byte":
         return to_byte(value, where)
     # integers
@@ -571,7 +580,14 @@ def _check_scalar(ftype: FieldType, value: Any, where: str) -> None:
             raise FieldError(f"{where}: expects a string, got {_show(value)}")
         if ftype.string_bound and len(value) > ftype.string_bound:
             raise FieldError(f"{where}: string longer than its bound {ftype.string_bound}")
+        if not value.isascii():
+            try:
+                value.encode()
+            except UnicodeEncodeError as err:
+                raise FieldError(f"{where}: not UTF-8 text ({err.reason})") from None
         return
     if ftype.base in FLOATS and isinstance(value, str):
         raise FieldError(f"{where}: expects a {ftype.base} number, got {_show(value)}")
+    if ftype.base in INTEGER_RANGES and isinstance(value, float):  # (packed as given)
+        raise FieldError(f"{where}: expects a whole number ({ftype.base}), got {_show(value)}")
     convert_scalar(ftype, value, where)

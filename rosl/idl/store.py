@@ -42,6 +42,21 @@ _SERIALIZE_ERRORS = (
 )
 
 
+def _bounded_inside(cls: Any, seen: frozenset[Any] = frozenset()) -> bool:
+    """Whether a message nested in ``cls``'s fields has a bounded string or sequence."""
+    for attr, ftype in zip(cls._fields, cls._field_types, strict=True):
+        if ftype.is_primitive:
+            continue
+        inner = cls._field_classes[attr]
+        if inner in seen:
+            continue
+        if any(t.string_bound or t.array is ArrayKind.BOUNDED for t in inner._field_types):
+            return True
+        if _bounded_inside(inner, seen | {cls}):
+            return True
+    return False
+
+
 def field_desc(ftype: FieldType) -> Any:
     """Return rosbags' field descriptor for one of our field types."""
     if ftype.is_primitive:
@@ -152,7 +167,7 @@ class Store:
         special = getattr(cls, "_has_bytes", True) or getattr(cls, "_has_sequences", True)
         plain = None if special else cls
         flat = None if plain is None else flat_serializer(cls)
-        checked = type_name in self._checked
+        checked = type_name in self._checked or _bounded_inside(cls)
 
         def failed(message: Message, err: Exception) -> FieldError:
             check_fields(message)  # names the field when it can

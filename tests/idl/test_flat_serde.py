@@ -95,3 +95,47 @@ def test_fields_named_as_python_keywords_serialize_in_every_case(make_package) -
         raw = store.serialize(message)
         assert raw[4:5] == b"\x07"
         assert store.deserialize(raw, "keywords_pkg/msg/Keywords") == message
+
+
+def test_a_bounded_string_in_a_nested_message_is_checked_as_in_its_own(make_package) -> None:
+    make_package(
+        "bounds_pkg", {"msg/Inner.msg": "string<=3 name\n", "msg/Outer.msg": "Inner inner\n"}
+    )
+    outer = registry.get_message_class("bounds_pkg/msg/Outer")()
+    outer.inner.name = "abc"
+    registry.store().serialize(outer)
+    outer.inner.name = "toolong"  # (assignment does not check; sending does, as rclpy's)
+    for serialize in (registry.store().serialize, registry.store().serializer(outer.__msgtype__)):
+        with pytest.raises(FieldError, match=r"Outer\.inner\.name: string longer than its bound 3"):
+            serialize(outer)
+
+
+@pytest.mark.parametrize(
+    ("type_name", "value", "expected"),
+    [
+        ("std_msgs/msg/Int8", 1.0, r"Int8\.data: expects a whole number \(int8\), got float 1.0"),
+        ("std_msgs/msg/Float32", 1e39, r"Float32\.data: float 1e\+39 is out of range for float32"),
+        ("std_msgs/msg/Float64", 10**400, r"Float64\.data: int 1000.* is out of range for float64"),
+        (
+            "std_msgs/msg/String",
+            "a\udc80",
+            r"String\.data: not UTF-8 text \(surrogates not allowed\)",
+        ),
+    ],
+)
+def test_a_value_its_field_cannot_carry_is_one_error_naming_the_field(
+    type_name: str, value: object, expected: str
+) -> None:
+    message = registry.get_message_class(type_name)()
+    message.data = value
+    store = registry.store()
+    for serialize in (store.serialize, store.class_serializer(type(message))):
+        with pytest.raises(FieldError, match=expected):
+            serialize(message)
+
+
+def test_float_fields_keep_infinities_and_nan() -> None:
+    message = registry.get_message_class("std_msgs/msg/Float32")(data=float("inf"))
+    assert registry.store().deserialize(
+        registry.store().serialize(message), "std_msgs/msg/Float32"
+    ).data == float("inf")
