@@ -58,8 +58,9 @@ class _SerdeNumpy:
         value = getattr(np, name)
         loaded = sys.modules.get("numpy")
         if loaded is not None:  # no call through here any more (one per array per message)
-            while _compiled:
-                _compiled.pop().numpy = loaded  # type: ignore[attr-defined]
+            for module in _compiled[:]:  # (two threads may get here at once: no pop races)
+                module.numpy = loaded  # type: ignore[attr-defined]
+            _compiled.clear()
         return value
 
 
