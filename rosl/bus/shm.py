@@ -265,7 +265,7 @@ class SharedMemory:
         """A ring for messages of ``size`` bytes, in place of ``old`` (None: shm is off)."""
         capacity = max(MIN_CAPACITY, size + size // HEADROOM)
         if old is not None:
-            capacity = max(capacity, old.capacity + old.capacity // HEADROOM)  # fewer rounds
+            capacity = max(capacity, 2 * old.capacity)  # a growing size: few rings retired
         slots = max(MIN_SLOTS, min(MAX_SLOTS, RING_BYTES // capacity))
         incarnation = 1 if old is None else old.incarnation + 1
         if old is not None:
