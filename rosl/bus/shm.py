@@ -71,10 +71,12 @@ MIN_SLOTS, MAX_SLOTS = 4, 1024
 MIN_CAPACITY = 4096
 # a ring its publisher goes round in less than LAP_S gets twice the slots, up to
 # RING_MAX_BYTES (and shm_ring's slot limit): a subscriber that a loaded machine stalls for a
-# few scheduler slices must find its messages still there (1 MiB at 4 GB/s: 64 MiB is 16 ms,
-# 256 MiB 64 ms). Slow publishers keep the small ring.
+# few scheduler slices must find its messages still there. Deeper costs speed: a subscriber
+# that falls behind reads what left the CPU's caches (measured, bench/bus_throughput.py, 1 MiB
+# flat out: 63 MiB 8.3k msg/s, 96 MiB 6.5k, 128 MiB 5.1k, 256 MiB 3.7k; paced at 80 %, 63 MiB
+# lost 2 %, 96 MiB and more nothing). Slow publishers keep the first ring.
 LAP_S = 0.1
-RING_MAX_BYTES = 256 * 1024 * 1024
+RING_MAX_BYTES = 96 * 1024 * 1024
 HEADROOM = 8  # a slot holds the first message's size and an eighth more (pages, at least)
 SWEEP_S = 30.0
 RETIRE_S = 5.0  # a ring replaced by a bigger one (or of a closed publisher) is unlinked this late

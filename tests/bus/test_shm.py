@@ -490,7 +490,7 @@ from rosl.bus.shm import SharedMemory
 
 folder = sys.argv[1]
 first = SharedMemory(domain=0, directory=folder, lap_s=1e9)  # every lap is a quick one
-for i in range(130):  # 1 MiB messages: 56 slots (63 MiB), then twice as many would be asked
+for i in range(130):  # 1 MiB messages: 56 slots (63 MiB), then a deeper ring would be asked
     assert first.put(1, 1, bytes(1024 * 1024)) is not None
 print("first", first._rings[(1, 1)].slots, (1, 1) in first._no_room, flush=True)
 second = SharedMemory(domain=0, directory=folder)  # another publisher's first ring still fits
@@ -504,8 +504,8 @@ print("second", second.put(2, 1, bytes(1024 * 1024)) is not None, second._failed
 def test_a_ring_is_not_deepened_into_the_last_quarter_of_a_small_dev_shm(
     processes: Processes, tmp_path: Path
 ) -> None:
-    # 200 MiB: the first ring (63 MiB) and one twice as deep (126 MiB) would leave 11 MiB,
-    # too little for another publisher's first ring: the ring stays as it is
+    # 200 MiB: the first ring (63 MiB) and a deeper one (96 MiB) would leave 41 MiB, less
+    # than another publisher's first ring: the ring stays as it is
     folder = tmp_path / "shm"
     folder.mkdir()
     private = f'mount -t tmpfs -o size=200m tmpfs {folder} && exec "$@"'
