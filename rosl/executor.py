@@ -606,6 +606,11 @@ class Executor:
             elif self._collect(chosen, batch):
                 item, node = batch[0]
                 if not isinstance(item, Task):  # this look found it ready and runnable
+                    if item._is_timer and not waited and changes is not None:
+                        # always due (its callback outlasts its period): what arrives must
+                        # still be read; the next look collects it
+                        assert participant is not None  # (changes was read from it)
+                        self._polled_first(False, participant, changes)
                     batch.popleft()
                     item._executor_event = True  # not offered again until taken
                     return item, node

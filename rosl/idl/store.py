@@ -42,8 +42,10 @@ _SERIALIZE_ERRORS = (
 )
 
 
-def _bounded_inside(cls: Any, seen: frozenset[Any] = frozenset()) -> bool:
+def _bounded_inside(cls: Any, seen: set[Any] | None = None) -> bool:
     """Whether a message nested in ``cls``'s fields has a bounded string or sequence."""
+    seen = set() if seen is None else seen
+    seen.add(cls)  # (each nested type is looked at once, however often it is used)
     for attr, ftype in zip(cls._fields, cls._field_types, strict=True):
         if ftype.is_primitive:
             continue
@@ -52,7 +54,7 @@ def _bounded_inside(cls: Any, seen: frozenset[Any] = frozenset()) -> bool:
             continue
         if any(t.string_bound or t.array is ArrayKind.BOUNDED for t in inner._field_types):
             return True
-        if _bounded_inside(inner, seen | {cls}):
+        if _bounded_inside(inner, seen):
             return True
     return False
 

@@ -1414,6 +1414,18 @@ def test_a_timer_that_outlasts_its_period_does_not_keep_messages_from_being_read
         talker.publish(String(data=f"m{i}"))
     assert spin_until(executor, lambda: len(heard) == 3), heard
     assert heard == ["m0", "m1", "m2"]
+    # and the usual look (a change was notified: a new node here) polls too, for messages
+    # sent from another thread while the timer keeps overrunning
+    ros.Node("overrun_bystander")
+
+    def talk() -> None:
+        for i in range(3, 13):
+            talker.publish(String(data=f"m{i}"))
+            time.sleep(0.02)
+
+    threading.Thread(target=talk, daemon=True).start()
+    assert spin_until(executor, lambda: len(heard) == 13), heard
+    assert heard == [f"m{i}" for i in range(13)]
 
 
 def test_an_executor_that_decides_can_execute_itself_is_asked_for_timers_too(ros):
