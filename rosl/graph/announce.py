@@ -88,6 +88,7 @@ class Discovery:
         self._lock = threading.Lock()
         self._announce_due = 0.0
         self._pending_replies: list[str] = []  # "querier:qid" we still owe an answer
+        self._later: list[tuple[float, dict[str, Any]]] = []  # (when, op) to send again
         self._stopping = False
         self._has_announced = False
         self.started = time.monotonic()  # when discovery began listening
@@ -184,9 +185,17 @@ class Discovery:
         """What the discovery channel refused so far, by reason (see ``Reader.dropped``)."""
         return self._reader.dropped()
 
-    def send(self, message: dict[str, Any]) -> None:
-        """Send another op (e.g. ``replay``) to every process."""
+    def send(self, message: dict[str, Any], again_after: float | None = None) -> None:
+        """Send another op (e.g. ``replay``) to every process.
+
+        With ``again_after``, the discovery thread sends it once more that many seconds later:
+        for a one-off request whose loss nothing else would repair (a late subscriber's ask
+        for history); receivers must take it twice as once.
+        """
         self._send(message)
+        if again_after is not None:
+            with self._lock:
+                self._later.append((time.monotonic() + again_after, message))
 
     # --- the thread --------------------------------------------------------------------------
 
@@ -232,12 +241,24 @@ class Discovery:
                     print(f"rosl: discovery: cannot announce: {err}", file=sys.stderr)
             for process in self.cache.expire(now):
                 self._gone(process.sender)
+            if self._later:
+                self._send_due(now)
             self._check_selftest(now)
             wait = max(0.0, min(self._announce_due - time.monotonic(), 0.5))
             deliveries.clear()
             self._receiver.poll(wait, deliveries)
             for delivery in deliveries:
                 self._handle(delivery)
+
+    def _send_due(self, now: float) -> None:
+        with self._lock:
+            due = [message for when, message in self._later if when <= now]
+            self._later = [(when, message) for when, message in self._later if when > now]
+        for message in due:
+            try:
+                self._send(message)
+            except Exception as err:  # (as an announcement's: the thread goes on)
+                print(f"rosl: discovery: cannot send: {err}", file=sys.stderr)
 
     def _check_selftest(self, now: float) -> None:
         if self.loopback_ok.is_set() or self._warned or now - self.started < SELFTEST_S:

@@ -44,6 +44,7 @@ _LOCKSTEP = int(Flags.LOCKSTEP)
 LOSS_REPORT_EVERY_NS = 5_000_000_000
 KEEP_ALL_LIMIT = 1 << 16  # deliveries a keep-all subscription holds before dropping the oldest
 MAX_PEERS = 4096  # publishers a subscription remembers what the graph said of
+HISTORY_ASKED_AGAIN_S = 1.0  # a late transient-local subscription asks for history again
 MAX_LOSS_SOURCES = 16  # publishers whose loss a subscription's record names (the worst first)
 
 
@@ -145,12 +146,15 @@ class Subscription(Queued):
         return self.topic
 
     def _request_history(self) -> None:
+        # asked again a second later: the ask is one datagram, and nothing else would repair
+        # its loss (a replay that comes twice is taken once: see deliver)
         self.node.participant.discovery.send(
             {
                 "op": "replay",
                 "topic": self.topic,
                 "target": [f"{self._sender:016x}", self.endpoint],
-            }
+            },
+            again_after=HISTORY_ASKED_AGAIN_S,
         )
 
     def deliver(self, delivery: Delivery) -> None:
@@ -164,6 +168,8 @@ class Subscription(Queued):
             address = delivery.address
             if address is None or address[0] != self._sender or address[1] != self.endpoint:
                 return  # history asked for by another subscription
+            if (delivery.sender, delivery.endpoint, delivery.seq) in self._replayed:
+                return  # had already (the history was asked for twice)
         now = self.last_arrival_ns = _monotonic_ns()
         if self.peer_seen is not None:
             self._seen(delivery, now)

@@ -165,7 +165,7 @@ rosl.spin(node)
 """
 
 
-def _late_subscriber(ros, spawn, durability):
+def _late_subscriber(ros, spawn, durability, then=0.2):
     from std_msgs.msg import Int32
 
     from rosl.node.qos import QoSProfile
@@ -178,7 +178,7 @@ def _late_subscriber(ros, spawn, durability):
     node.create_subscription(Int32, "latched", lambda m: got.append(m.data), qos)
     # wait for the live message 6 (sent ~0.5 s after the subscription is seen), then a bit more
     assert spin_until(node, lambda: 6 in got, 20.0), f"no live message arrived: {got}"
-    spin_for(node, 0.2)
+    spin_for(node, then)
     return got
 
 
@@ -186,6 +186,17 @@ def test_a_late_transient_local_subscriber_gets_the_last_depth_messages_in_order
     from rosl.node.qos import DurabilityPolicy
 
     got = _late_subscriber(ros, spawn, DurabilityPolicy.TRANSIENT_LOCAL)
+    assert got[:3] == [3, 4, 5], got
+    assert set(got[3:]) == {6}, got
+
+
+def test_a_late_subscriber_asks_for_history_twice_and_gets_it_once(ros, spawn):
+    # the ask is one datagram: it goes again a second later (HISTORY_ASKED_AGAIN_S), and the
+    # replay that answers it again is not delivered again
+    from rosl.node.qos import DurabilityPolicy
+    from rosl.node.subscription import HISTORY_ASKED_AGAIN_S
+
+    got = _late_subscriber(ros, spawn, DurabilityPolicy.TRANSIENT_LOCAL, 2 * HISTORY_ASKED_AGAIN_S)
     assert got[:3] == [3, 4, 5], got
     assert set(got[3:]) == {6}, got
 
