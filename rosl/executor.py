@@ -20,6 +20,7 @@ the future completes, not by polling.
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import threading
@@ -106,6 +107,7 @@ class Executor:
         self._fast_looks = 0  # ... when the timer was handed out
         self._looking = 0  # threads inside _next_work
         self._idle_at: int | None = None  # the participant's changes when a look found nothing
+        self._one: tuple[Any, Callable[[], Any]] | None = None  # (a timer, its _one_timer look)
         # spin_once may take the timers-only way (_spin_timers): callbacks run on this thread
         cls = type(self)
         self._plain = cls._run is Executor._run and cls._next_work is Executor._next_work
@@ -273,13 +275,18 @@ class Executor:
             if answerer is None or answerer.seen:
                 return False
         changes, nodes = quiet
-        if len(nodes) == 1 and len(nodes[0].timers) == 1:
-            return self._spin_timer(nodes[0], nodes[0].timers[0], changes, deadline, participant)
+        if len(nodes) == 1 and len(nodes[0].timers) == 1:  # a publisher's: its timer alone
+            one = self._one
+            if one is None or one[0] is not nodes[0].timers[0]:
+                one = self._one = (nodes[0].timers[0], self._one_timer(*nodes, *nodes[0].timers))
+            look = one[1]
+        else:
+            look = functools.partial(self._due_timer, nodes)
         waited = False
         self._looking += 1
         try:
             while True:
-                due = self._due_timer(nodes)
+                due = look()
                 if isinstance(due, tuple):
                     if not self._polled_first(waited, participant, changes):
                         due[0]._executor_event = False
@@ -308,61 +315,35 @@ class Executor:
             task()
         return not timer._internal  # rosl's housekeeping: spin_once goes on to look for one
 
-    def _spin_timer(
-        self,
-        node: Node,
-        timer: Any,
-        changes: int,
-        deadline: float | None,
-        participant: Participant,
-    ) -> bool:
-        """:meth:`_spin_timers` for one node with one timer (a publisher's): asks it alone.
-
-        The same look as :meth:`_due_timer`'s for a single wall-time timer, with its clock
-        read directly; False (look the usual way) for anything else.
-        """
+    def _one_timer(self, node: Node, timer: Any) -> Callable[[], tuple[Any, Node] | float | None]:
+        """:meth:`_due_timer` for one node with one timer (a publisher): its clock read directly."""
         clock = timer.clock
         group = None if timer._ungrouped else timer.callback_group
         now_ns = time.monotonic_ns if clock.clock_type is ClockType.STEADY_TIME else time.time_ns
-        waited = False
-        self._looking += 1
-        try:
-            while True:
-                if (
-                    timer._canceled
-                    or timer._executor_event
-                    or clock._sim_ns is not None  # (sim-time timers are woken by /clock)
-                    or (group is not None and not group.can_execute(timer))
-                ):
-                    return False
-                until = timer._next_call_ns - now_ns()
-                if until <= 0:
-                    if not self._polled_first(waited, participant, changes):
-                        return False
-                    break
-                wait = until / 1e9
-                if deadline is not None:
-                    remaining = deadline - time.monotonic()
-                    if remaining <= 0 and waited:
-                        return True
-                    wait = min(wait, max(0.0, remaining))
-                waited = True
-                self._looks += 1
-                if participant.wait_change(wait, changes):
-                    self._quiet = None
-                    return False
-            timer._executor_event = True  # (as _due_timer hands it out)
-            self._fast = timer
-            self._fast_thread = threading.get_ident()
-            self._fast_looks = self._looks
-        finally:
-            self._looking -= 1
-        result = self._execute(timer, node)
-        if isinstance(result, CoroutineType):  # (as _run)
-            task: Task[Any] = Task(_given, (result,), executor=self)
-            task.entity, task.node = timer, node
-            task()
-        return not timer._internal
+        found = (timer, node)
+
+        def look() -> tuple[Any, Node] | float | None:
+            if (
+                timer._canceled
+                or timer._executor_event
+                or clock._sim_ns is not None  # (sim-time timers are woken by /clock)
+                or (group is not None and not group.can_execute(timer))
+            ):
+                return None
+            until: int = timer._next_call_ns - now_ns()
+            if until > 0:
+                return until / 1e9
+            self._hand_out(timer)
+            return found
+
+        return look
+
+    def _hand_out(self, timer: Any) -> None:
+        """Mark a timer a timers-only look found due as in flight, and remember who looked."""
+        timer._executor_event = True  # not offered again until taken
+        self._fast = timer
+        self._fast_thread = threading.get_ident()
+        self._fast_looks = self._looks
 
     def _polled_first(self, waited: bool, participant: Participant, changes: int) -> bool:
         """Before a timers-only look hands out a due timer: False when a poll found news.
@@ -695,10 +676,7 @@ class Executor:
                 if group is not None and not timer._ungrouped and not group.can_execute(timer):
                     continue
                 if until <= 0:
-                    timer._executor_event = True  # not offered again until taken
-                    self._fast = timer
-                    self._fast_thread = threading.get_ident()
-                    self._fast_looks = self._looks
+                    self._hand_out(timer)
                     return timer, node
                 if clock._sim_ns is None and (soonest is None or until < soonest):
                     soonest = until  # (sim-time timers are woken by /clock arriving)
