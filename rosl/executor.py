@@ -1,7 +1,7 @@
 """Executors: run the callbacks of the nodes added to them, as rclpy's do.
 
 Deliveries wait in their entity's queue (a subscription's, a service's, a client's; see
-:meth:`rosl.node.participant.Participant.dispatch`). One look at the entities of this
+:meth:`rosl.node.participant.Participant.poll`). One look at the entities of this
 executor's nodes only — queued deliveries, due timers, triggered guard conditions, ready
 waitables, tasks to resume — finds everything whose callback group lets it run, and hands
 those out one at a time before looking again; when nothing is ready the executor waits on the
@@ -109,12 +109,14 @@ class Executor:
         self._idle_at: int | None = None  # the participant's changes when a look found nothing
         self._one: tuple[Any, Callable[[], Any]] | None = None  # (a timer, its _one_timer look)
         # spin_once may take the timers-only way (_spin_timers): callbacks run on this thread
-        cls = type(self)
-        self._plain = cls._run is Executor._run and cls._next_work is Executor._next_work
-        # the timers-only looks (_due_timer, _spin_timer) do not call can_execute: not for an
+        # the timers-only looks (_due_timer, _one_timer) do not call can_execute: not for an
         # executor that decides it itself
+        cls = type(self)
         self._timers_only = cls.can_execute is Executor.can_execute
-        self._plain = self._plain and self._timers_only
+        self._plain = self._timers_only and (cls._run, cls._next_work) == (
+            Executor._run,
+            Executor._next_work,
+        )
         # a timers-only look handed out a due timer without polling the transport first (no
         # wait came before it): the next such look polls, so a timer that overruns its period
         # cannot keep what arrives from being read
@@ -289,8 +291,7 @@ class Executor:
                 due = look()
                 if isinstance(due, tuple):
                     if not self._polled_first(waited, participant, changes):
-                        due[0]._executor_event = False
-                        self._fast = None
+                        self._take_back(due[0])
                         return False
                     break
                 if due is None:  # no wall-time timer: the usual look waits without one
@@ -344,6 +345,11 @@ class Executor:
         self._fast = timer
         self._fast_thread = threading.get_ident()
         self._fast_looks = self._looks
+
+    def _take_back(self, timer: Any) -> None:
+        """Undo :meth:`_hand_out`: the timer was not given to run after all."""
+        timer._executor_event = False
+        self._fast = None
 
     def _polled_first(self, waited: bool, participant: Participant, changes: int) -> bool:
         """Before a timers-only look hands out a due timer: False when a poll found news.
@@ -580,8 +586,7 @@ class Executor:
                 if isinstance(due, tuple):
                     if participant is None or self._polled_first(waited, participant, changes):
                         return due
-                    due[0]._executor_event = False  # something arrived: look at it all
-                    self._fast = None
+                    self._take_back(due[0])  # something arrived: look at it all
                     continue
                 wait = due
             elif self._collect(chosen, batch):

@@ -74,7 +74,8 @@ MIN_CAPACITY = 4096
 # few scheduler slices must find its messages still there. Deeper costs speed: a subscriber
 # that falls behind reads what left the CPU's caches (measured, bench/bus_throughput.py, 1 MiB
 # flat out: 63 MiB 8.3k msg/s, 96 MiB 6.5k, 128 MiB 5.1k, 256 MiB 3.7k; paced at 80 %, 63 MiB
-# lost 2 %, 96 MiB and more nothing). Slow publishers keep the first ring.
+# lost up to 2 %, 96 MiB up to 1.5 % in 2 of 6 runs, 128 MiB and more nothing). Slow
+# publishers keep the first ring.
 LAP_S = 0.1
 RING_MAX_BYTES = 96 * 1024 * 1024
 HEADROOM = 8  # a slot holds the first message's size and an eighth more (pages, at least)

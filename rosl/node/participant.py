@@ -256,19 +256,8 @@ class Participant:
         """
         if self.changes != since:
             return True
-        lock = self._poll_lock
-        if self.closed or not lock.acquire(blocking=False):
+        if not self._poll_once(timeout, since):
             return self.wait(_never, timeout, since)
-        try:  # (_poll_once, one call less)
-            self._poller = threading.get_ident()
-            if self.changes == since:
-                self._poll_locked(timeout, None)
-        finally:
-            self._poller = None
-            lock.release()
-            if self._waiting:
-                with self._cond:
-                    self._cond.notify_all()
         return self.changes != since
 
     def _poll_once(self, timeout: float | None, snapshot: int) -> bool:
@@ -368,23 +357,15 @@ class Participant:
             if topics.count(topics[0]) == len(topics):  # one topic (fan-in): all at once
                 for take in self._takers.get(topics[0], ()):
                     take(deliveries)
-            else:
-                handlers = self._handlers  # (dispatch, one call less per message)
+            else:  # each to the handlers of its topic: node entities queue it for their
+                # executor, taps (monitors, the lock-step end) take it here, on this thread
+                handlers = self._handlers
                 for delivery in deliveries:
                     for handler in handlers.get(delivery.topic, ()):
                         handler.deliver(delivery)
         if deliveries:
             self.changes += 1  # queues filled: waiters look again
         return len(deliveries)
-
-    def dispatch(self, delivery: Delivery) -> None:
-        """Hand one delivery to the handlers of its topic/service hash.
-
-        Node entities queue it for their executor; taps (monitors, the simulator's lock-step
-        end) take it at once, on the polling thread.
-        """
-        for handler in self._handlers.get(delivery.topic, ()):
-            handler.deliver(delivery)
 
     def answer_lockstep(self) -> Answerer:
         """Start answering lock-stepped simulators (announced in this process's record)."""
