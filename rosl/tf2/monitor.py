@@ -20,6 +20,7 @@ from rosl.tf2.errors import Tf2ArgumentError, TransformException
 from rosl.tf2.program import run, spin_for, user_args
 
 NO_AUTHORITY = "<no authority available>"
+AUTHORITY_WAIT_S = 2.0  # how long a message of an unknown publisher waits for its name
 KEPT = 1000  # samples kept per frame and per broadcaster
 LOOK_EVERY_S = 0.5
 LOOKS_PER_REPORT = 21
@@ -159,13 +160,25 @@ def _subscribe(node: Any, tally: Tally) -> None:
     from rosl.node.qos import DurabilityPolicy, QoSProfile
 
     graph = node.participant.graph
+    waited: set[tuple[int, int, str]] = set()  # publishers whose name was waited for
     tf_message: Any = get_message_class("tf2_msgs/msg/TFMessage")
     for topic, durability in (("/tf", DurabilityPolicy.VOLATILE),
                               ("/tf_static", DurabilityPolicy.TRANSIENT_LOCAL)):  # fmt: skip
 
         def heard(message: Any, info: dict[str, Any], topic: str = topic) -> None:
             gid = info.get("publisher_gid")
-            found = graph.sender(gid[0], gid[1], PUBLISHER, topic) if gid else None
+            found = None
+            if gid:
+
+                def known() -> bool:
+                    return graph.sender(gid[0], gid[1], PUBLISHER, topic) is not None
+
+                # a latched /tf_static message is replayed at once, maybe before the graph
+                # has its publisher: give discovery a moment, once per publisher
+                if (gid[0], gid[1], topic) not in waited and not known():
+                    waited.add((gid[0], gid[1], topic))
+                    graph.wait_for(known, AUTHORITY_WAIT_S)
+                found = graph.sender(gid[0], gid[1], PUBLISHER, topic)
             tally.add(message, found[0].fqn if found else NO_AUTHORITY, time.time())
 
         node.create_subscription(tf_message, topic, heard,
