@@ -2,7 +2,9 @@
 
 Prints, per payload size, delivered messages/s and MB/s for plain Python multicast sockets
 (the baseline, measured in the same run) and for rosl's bus (a Writer in this process, a
-Reader draining the topic's channel in the subscriber), publisher flat out (saturation; a run
+Reader draining the topic's channel in the subscriber, reliable as a subscription's default
+QoS is, so a ring's writer waits for it: see ``rosl/bus/shm_ring.py``), publisher flat out
+(saturation; a run
 sends up to 2.4 GB, so that it measures what a path sustains rather than what its buffers
 absorb), with the ratio to the baseline and the loss. Messages above ``ROSL_SHM_THRESHOLD``
 (16 KiB), here 60 KB and 1 MiB, take rosl's shared memory. Then, for 64 B and 1 KB, the
@@ -17,7 +19,8 @@ ratio (aim: >= 0.9).
 Then the shared-memory path (``rosl/bus/shm.py``) for 1 MiB messages: rosl flat out (MB/s and
 loss), against a plain shared-memory ring + pipe in the same run (the baseline: slots in a
 /dev/shm file, indices through one pipe, credits back through another, one copy out per
-message, as rosl's reader makes; aim: ratio >= 0.5), the same messages over the wire
+message, as rosl's reader makes, and a writer that waits for its credits as rosl's waits
+for a reliable reader; aim: ratio >= 0.5), the same messages over the wire
 (``ROSL_SHM=0``), and rosl paced at 80 % of its flat-out rate (loss must be 0).
 
     python bench/bus_throughput.py [--count N] [--runs R] [--only-shm]
@@ -97,6 +100,7 @@ def sub_bus(count: int, size: int) -> None:
     reader = receiver.reader
     topic = topic_hash("/bench")
     reader.wanted.add(topic)
+    reader.held.add(topic)  # a reliable subscription (the default): rings wait for it
     receiver.join(channel_of(topic))
     print("ready", flush=True)
     out: list = []

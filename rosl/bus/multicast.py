@@ -464,6 +464,8 @@ class MulticastReceiver:
             self._closed = True
             sockets, self._sockets = list(self._sockets.values()), {}
             self._rewatch()
+        if self.reader.shm is not None:
+            self.reader.shm.release()  # writers stop waiting for this receiver's reads
         self.wake()
         for sock in sockets:
             sock.close()

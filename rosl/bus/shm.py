@@ -18,12 +18,12 @@ Where rings live: ``/dev/shm/rosl-u<uid>-d<domain>-p<pid>-<sender>-e<endpoint>-r
 mode 0600, created with ``O_EXCL|O_NOFOLLOW`` and memory reserved up front; readers open
 them only when they are regular files of their own user that nobody else can read.
 
-A ring starts at about :data:`RING_BYTES`, its slots the first message's size and an eighth
-more; a message that outgrows them gets a new ring of bigger slots, and a publisher that goes
-round its ring in less than :data:`LAP_S` one twice as deep (up to :data:`RING_MAX_BYTES`, and
-only while a quarter of the directory stays free for others' rings), so a subscriber stalled
-by a loaded machine still finds its messages. A forked child leaves its parent's rings to the
-parent and makes its own.
+A ring is about :data:`RING_BYTES`, its slots the first message's size and an eighth more; a
+message that outgrows them gets a new ring of slots twice as big. A subscriber that falls
+behind by a burst, or by a stall of a loaded machine, is waited for by a reliable publisher
+when it is reliable itself (see :mod:`rosl.bus.shm_ring`): rings need not be deeper than
+that, and deeper ones cost speed (a reader that far behind reads what has left the CPU's
+caches). A forked child leaves its parent's rings to the parent and makes its own.
 
 Lifetime (a lease held by the owning process): a ring is unlinked when its publisher's
 transport closes (and at interpreter exit); one replaced by a bigger ring, or whose publisher
@@ -51,8 +51,7 @@ import weakref
 from typing import TYPE_CHECKING
 
 from rosl.bus.errors import BusError
-from rosl.bus.shm_ring import MAX_SLOTS as RING_MAX_SLOTS
-from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner, segment_size
+from rosl.bus.shm_ring import Owner, RingReader, RingWriter, read_owner
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -65,19 +64,10 @@ DIRECTORY = "/dev/shm"
 # payload, no 64 KB datagram to copy through the kernel), and a ring's 1024 slots are 4-16
 # times the messages of 16-64 KB a 4 MiB socket buffer holds
 THRESHOLD = 16 * 1024
-RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring aims for at first
+RING_BYTES = 64 * 1024 * 1024  # memory one publisher's ring takes (less where /dev/shm is small)
 # slack: 64 MiB of 1 MiB messages is 30 ms at 2 GB/s; 1024 of 60 KB, 60 ms at 1 GB/s
 MIN_SLOTS, MAX_SLOTS = 4, 1024
 MIN_CAPACITY = 4096
-# a ring its publisher goes round in less than LAP_S gets twice the slots, up to
-# RING_MAX_BYTES (and shm_ring's slot limit): a subscriber that a loaded machine stalls for a
-# few scheduler slices must find its messages still there. Deeper costs speed: a subscriber
-# that falls behind reads what left the CPU's caches (measured, bench/bus_throughput.py, 1 MiB
-# flat out: 63 MiB 8.3k msg/s, 96 MiB 6.5k, 128 MiB 5.1k, 256 MiB 3.7k; paced at 80 %, 63 MiB
-# lost up to 2 %, 96 MiB up to 1.5 % in 2 of 6 runs, 128 MiB and more nothing). Slow
-# publishers keep the first ring.
-LAP_S = 0.1
-RING_MAX_BYTES = 96 * 1024 * 1024
 HEADROOM = 8  # a slot holds the first message's size and an eighth more (pages, at least)
 SWEEP_S = 30.0
 RETIRE_S = 5.0  # a ring replaced by a bigger one (or of a closed publisher) is unlinked this late
@@ -212,17 +202,14 @@ def sweep(directory: str = DIRECTORY, uid: int | None = None) -> list[str]:
 class SharedMemory:
     """A transport's shared memory: its publishers' rings, readers for its receivers."""
 
-    def __init__(self, domain: int, directory: str = DIRECTORY, lap_s: float = LAP_S) -> None:
+    def __init__(self, domain: int, directory: str = DIRECTORY) -> None:
         self.domain = domain
-        self.lap_s = lap_s  # a ring gone round faster gets deeper (see _lapped)
         self.directory = directory
         self.host = host_identity()
         self.threshold = threshold()
         self.uid = os.geteuid()
         self._owner = this_process()
         self._rings: dict[tuple[int, int], RingWriter] = {}
-        self._lap_started: dict[tuple[int, int], float] = {}  # when each ring's lap began
-        self._no_room: set[tuple[int, int]] = set()  # rings /dev/shm had no room to deepen
         # rings no longer written, kept until a deadline for readers that have not mapped
         # them yet (descriptors of their last messages may still wait in a socket)
         self._retired: list[tuple[float, RingWriter]] = []
@@ -241,8 +228,11 @@ class SharedMemory:
         name = segment_name(self.uid, self.domain, pid, sender, endpoint, incarnation)
         return os.path.join(self.directory, name)
 
-    def put(self, sender: int, endpoint: int, payload: Buffer) -> bytes | None:
+    def put(self, sender: int, endpoint: int, payload: Buffer, hold: bool = True) -> bytes | None:
         """Write a message into the endpoint's ring; its descriptor, or None (send the bytes).
+
+        ``hold`` (a reliable publisher): wait, bounded, for reliable readers about to lose
+        messages (see :mod:`rosl.bus.shm_ring`).
 
         The ring is made on first use and made anew, bigger, when a message outgrows it (the
         old one is unlinked :data:`RETIRE_S` later: a subscriber may not have mapped it yet).
@@ -250,6 +240,11 @@ class SharedMemory:
         if self._failed:
             return None
         size = len(payload)
+        if hold:  # (waits without the lock: other publishers of the process go on)
+            ring = self._rings.get((sender, endpoint))
+            if ring is not None and size <= ring.capacity:
+                with contextlib.suppress(ValueError):  # (closed by another thread meanwhile)
+                    ring.make_room()
         with self._lock:
             if time.monotonic() >= self._next_due:
                 self._due()
@@ -259,10 +254,7 @@ class SharedMemory:
                 ring = self._grow(key, ring, size)
                 if ring is None:
                     return None
-            descriptor = ring.put(payload)
-            if not ring.written % ring.slots:  # a lap ends
-                self._lapped(key, ring)
-            return descriptor
+            return ring.put(payload)
 
     def _grow(self, key: tuple[int, int], old: RingWriter | None, size: int) -> RingWriter | None:
         """A ring for messages of ``size`` bytes, in place of ``old`` (None: shm is off)."""
@@ -286,46 +278,7 @@ class SharedMemory:
             )
             return None
         self._rings[key] = ring
-        self._lap_started[key] = time.monotonic()
         return ring
-
-    def _lapped(self, key: tuple[int, int], ring: RingWriter) -> None:
-        """A lap of ``ring`` ended: one that took less than ``lap_s`` gets a ring twice as deep.
-
-        The new ring has the same slot size; the old one is retired as when a message outgrows
-        it. Where /dev/shm has no room for it, the old ring stays, and grows no more.
-        """
-        now = time.monotonic()
-        started = self._lap_started.get(key, now)
-        self._lap_started[key] = now
-        slots = min(ring.slots * 2, RING_MAX_SLOTS, RING_MAX_BYTES // ring.capacity)
-        if now - started >= self.lap_s or slots <= ring.slots or key in self._no_room:
-            return
-        if not self._room_for(segment_size(slots, ring.capacity)):
-            self._no_room.add(key)  # a deeper ring would crowd out others' first rings
-            return
-        incarnation = ring.incarnation + 1
-        path = self.path(*key, self._owner.pid, incarnation)
-        try:
-            bigger = self._make(path, incarnation, slots, ring.capacity)
-        except OSError:
-            bigger = None
-        if bigger is None or bigger.slots <= ring.slots:
-            if bigger is not None:
-                bigger.close()
-            self._no_room.add(key)
-            return
-        self._retire(ring)
-        self._rings[key] = bigger
-
-    def _room_for(self, size: int) -> bool:
-        """Whether ``size`` more bytes leave room in the directory: a quarter, and a ring."""
-        try:
-            info = os.statvfs(self.directory)
-        except OSError:
-            return False
-        left = info.f_bavail * info.f_frsize - size
-        return left >= max(RING_BYTES, info.f_blocks * info.f_frsize // 4)
 
     def _forked(self) -> None:
         """In a child forked from this process: the parent's rings are the parent's.
@@ -339,8 +292,6 @@ class SharedMemory:
             ring.close(unlink=False)
         self._rings.clear()
         self._retired.clear()
-        self._lap_started.clear()
-        self._no_room.clear()
         self._owner = this_process()
         self._finalizer = weakref.finalize(
             self, _close_rings, self._rings, self._retired, os.getpid()
@@ -360,8 +311,6 @@ class SharedMemory:
         """An endpoint is gone: unlink its ring (:data:`RETIRE_S` later)."""
         with self._lock:
             ring = self._rings.pop((sender, endpoint), None)
-            self._lap_started.pop((sender, endpoint), None)
-            self._no_room.discard((sender, endpoint))
             if ring is not None:
                 self._retire(ring)
 

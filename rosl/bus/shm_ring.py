@@ -7,24 +7,33 @@ the message out. Policy (when to use a ring, names, cleanup) lives in :mod:`rosl
 
 Layout: the file starts with the :data:`HEADER` (magic, slots, slot capacity, owner pid, the
 owner's process start time and pid namespace, which the cleanup pass checks) and from byte 64
-one 8-byte *generation* per slot, in as many pages as they take (:func:`data_at`: one page up
-to 504 slots); slot ``i``'s bytes start after those pages, at ``data_at(slots) + i *
-capacity``.
+one 8-byte *generation* per slot, in as many pages as they take (one page up to 504 slots),
+then a page of reader entries (:func:`readers_at`); slot ``i``'s bytes start after that, at
+``data_at(slots) + i * capacity``.
 
 Safety against a slow subscriber (a seqlock per slot): the writer of message ``n`` sets the
 slot's generation to ``2n - 1`` (odd: being written), copies the payload, then sets it to
 ``2n``. A reader of message ``n`` checks the generation is ``2n``, copies the bytes out, and
 checks it again; any other value means the slot was (or is being) reused for a newer message:
-the read is refused and counted (``overwritten``), never delivered torn. The writer never
-waits for readers, so a subscriber that falls more than a ring behind loses the oldest
-messages, counted as loss, as a full socket buffer would drop them. A reader that finds the
-writer within a sixteenth of the ring (a slot at least) of reusing the slot it is about to
-copy does not copy (the copy would likely end torn, and at that distance its source has left
-the CPU's caches): it drops that many messages, counted the same way, and goes on with the
-next; skipping further, to the newest messages, measured no faster for a reader that stays
-behind, and lost more to a passing stall. The checks rely on stores becoming visible in
-program order, as on x86-64; the slot is only reused after a whole ring of newer messages,
-which bounds the window on weaker CPUs to that lap.
+the read is refused and counted (``overwritten``), never delivered torn. A reader that finds
+the writer within a sixteenth of the ring (a slot at least) of reusing the slot it is about
+to copy does not copy (the copy would likely end torn, and at that distance its source has
+left the CPU's caches): it drops that many messages, counted the same way, and goes on with
+the next; skipping further, to the newest messages, measured no faster for a reader that
+stays behind, and lost more to a passing stall. The checks rely on stores becoming visible
+in program order, as on x86-64; the slot is only reused after a whole ring of newer
+messages, which bounds the window on weaker CPUs to that lap.
+
+Reliable readers hold the writer back, briefly (as a DDS reliable writer blocks for its
+readers, up to ``max_blocking_time``): a reader of a reliable subscription takes an entry in
+the readers' page (under ``flock``, so two readers never take one) and writes into it the
+number of the last message it is done with and when. A reliable writer about to begin a
+message that would push such a reader into dropping waits, in steps of 50 µs, while that
+reader read something in the last :data:`HOLD_NS` and for :data:`MAX_WAIT_NS` at most; then
+it writes on, and the reader loses what it did not read, counted as before. So a burst, or
+the page faults of a new ring's first lap, slows the publisher instead of costing messages,
+while a subscriber busy elsewhere (a long callback, a crash, an exit) costs it at most
+:data:`HOLD_NS` once. Best-effort publishers and subscribers never wait and never hold.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
@@ -44,11 +53,14 @@ transports, not a slot store next to ours.
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import itertools
 import mmap
 import os
 import stat
 import struct
 import sys
+import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -61,12 +73,22 @@ if TYPE_CHECKING:
     # (sender, endpoint, pid, incarnation) -> the ring's path (see shm.py)
     Namer = Callable[[int, int, int, int], str]
 
-MAGIC = b"RLSHM\x00\x02\x00"  # layout 2: the generations take as many pages as they need
+MAGIC = b"RLSHM\x00\x03\x00"  # layout 3: a page of reader entries before the slots
 HEADER = struct.Struct("<8sIIIIQQ")  # magic, slots, capacity, pid, -, start time, pid ns
 GENERATIONS_AT = 64
 PAGE = mmap.PAGESIZE
 MAX_SLOTS = 4096  # slots one ring may have (its generations then take 9 pages)
 DESCRIPTOR = struct.Struct("<IIQI")  # pid, incarnation, message number, length
+# the readers' page: a count of its changes (4 u64, the first used), then one entry of 4 u64
+# per reader: its token (pid and a number; 0: a free entry), cursor (the last message it is
+# done with), stamp (CLOCK_MONOTONIC ns of its last read) and flags
+ENTRIES = PAGE // 32
+FIRST_ENTRY = 4
+HOLD = 1  # an entry's flag: the reader is reliable (its writer waits for it, see below)
+HOLD_NS = 10_000_000  # a reader that read nothing for this long is not waited for
+MAX_WAIT_NS = 100_000_000  # one message waits at most this long (DDS's max_blocking_time)
+CLAIM_STALE_NS = 10_000_000_000  # an entry untouched this long is free for another reader
+_TOKENS = itertools.count(1)  # with the pid: who took a ring's entry
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
 POOLED = 8  # buffers kept per ring size beyond those one drain's copies take
 DRAIN_BYTES = 1024 * 1024  # copies one drain of a receiver makes at most (see wire.py)
@@ -77,9 +99,14 @@ def _round_up(value: int, step: int) -> int:
     return -(-value // step) * step
 
 
-def data_at(slots: int) -> int:
-    """Where slot 0 starts in a ring of ``slots`` slots: after the header and generations."""
+def readers_at(slots: int) -> int:
+    """Where the readers' page of a ring of ``slots`` slots starts: after the generations."""
     return _round_up(GENERATIONS_AT + 8 * slots, PAGE)
+
+
+def data_at(slots: int) -> int:
+    """Where slot 0 starts in a ring of ``slots`` slots: after the readers' page."""
+    return readers_at(slots) + PAGE
 
 
 def segment_size(slots: int, capacity: int) -> int:
@@ -146,8 +173,35 @@ class RingWriter:
         self._map[: HEADER.size] = header
         self._view = memoryview(self._map)
         self._generations = self._view[GENERATIONS_AT : GENERATIONS_AT + 8 * self.slots].cast("Q")
+        at = readers_at(self.slots)
+        self._entries = self._view[at : at + PAGE].cast("Q")
+        self._margin = max(1, self.slots // 16)  # (as the reader's, see _Mapped)
+        self._held: list[int] = []  # entries of reliable readers (first words' indexes)
+        self._changes = 0  # the readers' page's count of changes when _held was looked up
         self._next = 1
+        self.hold_ns = HOLD_NS  # (tests lengthen these two: a loaded machine's stalls)
+        self.max_wait_ns = MAX_WAIT_NS
+        self.waited = 0  # messages that waited for a reliable reader
+        self.waited_out = 0  # ... until MAX_WAIT_NS, then overwrote what it had not read
         self.closed = False
+
+    def make_room(self) -> None:
+        """Wait, bounded, for reliable readers the next message would push into dropping.
+
+        A reliable publisher's, before :meth:`put` (see the module docstring); it only reads
+        the ring, so it needs no lock (a ring closed meanwhile ends the wait).
+        """
+        if self.closed:
+            return
+        entries = self._entries
+        if entries[0] != self._changes:  # a reader came or went
+            self._held = self._holders()
+        if self._held:
+            need = self._next - self.slots + self._margin  # a reader's cursor must be this far
+            for index in self._held:
+                if entries[index + 1] < need:
+                    self._wait(need)
+                    return
 
     def put(self, payload: Buffer) -> bytes:
         """Write one message into the next slot; return its descriptor (for the datagram)."""
@@ -164,6 +218,38 @@ class RingWriter:
         generations[slot] = 2 * number
         return DESCRIPTOR.pack(self._pid, self.incarnation, number, size)
 
+    def _holders(self) -> list[int]:
+        """Where the entries of reliable readers are (their first word's index)."""
+        entries = self._entries
+        self._changes = entries[0]
+        return [
+            index
+            for index in range(FIRST_ENTRY, 4 * ENTRIES, 4)
+            if entries[index] and entries[index + 3] & HOLD
+        ]
+
+    def _wait(self, need: int) -> None:
+        """Wait while a reliable reader that is reading has not reached ``need``."""
+        entries, clock, hold_ns = self._entries, time.monotonic_ns, self.hold_ns
+        deadline = clock() + self.max_wait_ns
+        waits = self.waited
+        while not self.closed:
+            now = clock()
+            behind = [
+                index
+                for index in self._held
+                if entries[index]
+                and entries[index + 1] < need
+                and now - entries[index + 2] < hold_ns
+            ]
+            if not behind:
+                return
+            if now >= deadline:
+                self.waited_out += 1
+                return
+            self.waited = waits + 1
+            time.sleep(50e-6)
+
     @property
     def written(self) -> int:
         """How many messages were written into the ring."""
@@ -175,6 +261,7 @@ class RingWriter:
             return
         self.closed = True
         self._generations.release()
+        self._entries.release()
         self._view.release()
         self._map.close()
         if unlink:
@@ -183,9 +270,14 @@ class RingWriter:
 
 
 class _Mapped:
-    """One ring as a reader sees it: read-only, checked before use."""
+    """One ring as a reader sees it: read-only (but for its entry), checked before use.
+
+    ``fd`` becomes this object's (closed with it): a reliable reader takes its entry under
+    ``flock`` on it, and writes the entry through a mapping of the readers' page alone.
+    """
 
     def __init__(self, fd: int) -> None:
+        self.fd = fd
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode) or info.st_uid != os.geteuid():
             raise PermissionError("not a regular file of this user")
@@ -209,11 +301,65 @@ class _Mapped:
         self.skip_below = 0  # descriptors of older messages are dropped without a look
         self.view = memoryview(self.map)
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
+        self.entry = -1  # our entry's first word in ``entries`` (-1: none taken)
+        self.token = 0
+        self._page: mmap.mmap | None = None
+        self.entries: memoryview | None = None
+
+    def claim(self, token: int, number: int) -> bool:
+        """Take a free entry for a reliable reader about to read ``number`` (False: none)."""
+        try:
+            if self.entries is None:
+                self._page = mmap.mmap(
+                    self.fd, PAGE, mmap.MAP_SHARED, offset=readers_at(self.slots)
+                )
+                self.entries = memoryview(self._page).cast("Q")
+            entries = self.entries
+            fcntl.flock(self.fd, fcntl.LOCK_EX)
+        except (OSError, ValueError):
+            return False  # (a ring file we may only read: we read without holding it)
+        try:
+            now = time.monotonic_ns()
+            for index in range(FIRST_ENTRY, 4 * ENTRIES, 4):
+                if not entries[index] or now - entries[index + 2] >= CLAIM_STALE_NS:
+                    entries[index + 1] = number - 1
+                    entries[index + 2] = now
+                    entries[index + 3] = HOLD
+                    entries[index] = token
+                    entries[0] += 1  # (the writer looks again)
+                    self.entry, self.token = index, token
+                    return True
+            return False
+        finally:
+            fcntl.flock(self.fd, fcntl.LOCK_UN)
+
+    def release(self) -> None:
+        """Give our entry back (its writer stops waiting for us at once)."""
+        entries, entry = self.entries, self.entry
+        self.entry = -1
+        if entries is None or entry < 0 or entries[entry] != self.token:
+            return
+        with contextlib.suppress(OSError):
+            fcntl.flock(self.fd, fcntl.LOCK_EX)
+        try:
+            if entries[entry] == self.token:
+                entries[entry + 3] = 0
+                entries[entry] = 0
+                entries[0] += 1
+        finally:
+            with contextlib.suppress(OSError):
+                fcntl.flock(self.fd, fcntl.LOCK_UN)
 
     def close(self) -> None:
+        self.release()
+        if self.entries is not None:
+            self.entries.release()
+        if self._page is not None:
+            self._page.close()
         self.generations.release()
         self.view.release()
         self.map.close()
+        os.close(self.fd)
 
 
 class _Buffers:
@@ -285,8 +431,14 @@ class RingReader:
         self.overwritten = 0
         self.unmapped = 0
 
-    def read(self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap) -> memoryview | None:
-        """The message a descriptor names (one copy, read-only), or None (counted) if gone."""
+    def read(
+        self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap, hold: bool = False
+    ) -> memoryview | None:
+        """The message a descriptor names (one copy, read-only), or None (counted) if gone.
+
+        With ``hold`` (a reliable subscription reads it), the reader's entry in the ring says
+        how far it got, so a reliable writer waits for it (see the module docstring).
+        """
         if len(descriptor) != DESCRIPTOR.size:
             self.unmapped += 1
             return None
@@ -295,6 +447,22 @@ class RingReader:
         if ring is None or size > ring.capacity:  # (writers number from 1: 0 was never written)
             self.unmapped += 1
             return None
+        if hold:
+            data = self._read(ring, number, size)
+            entries = ring.entries
+            if entries is None or ring.entry < 0 or entries[ring.entry] != ring.token:
+                if not ring.claim(next(_TOKENS) | os.getpid() << 32, number):
+                    return data
+                entries = ring.entries
+                assert entries is not None
+            entry = ring.entry
+            entries[entry + 2] = time.monotonic_ns()
+            entries[entry + 1] = max(number, ring.skip_below - 1)
+            return data
+        return self._read(ring, number, size)
+
+    def _read(self, ring: _Mapped, number: int, size: int) -> memoryview | None:
+        """Copy message ``number`` of ``size`` bytes out of ``ring`` (None: counted, gone)."""
         if number < ring.skip_below:  # older than what this reader caught up to
             self.overwritten += 1
             return None
@@ -332,22 +500,32 @@ class RingReader:
         if self._on_map is not None:
             self._on_map()
         path = self._name_of(*key)
-        try:
-            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
-        except OSError:
+        fd = -1
+        for mode in (os.O_RDWR, os.O_RDONLY):  # (read-write for a reliable reader's entry)
+            with contextlib.suppress(OSError):
+                fd = os.open(path, mode | os.O_NOFOLLOW | os.O_CLOEXEC)
+                break
+        if fd < 0:
             return None
         try:
             ring = _Mapped(fd)
         except (OSError, ValueError, struct.error):
-            return None
-        finally:
             os.close(fd)
+            return None
         for old in [k for k in self._maps if k[:3] == key[:3] and k[3] < key[3]]:
             self._maps.pop(old).close()  # the ring grew: its older incarnation is done
         if len(self._maps) >= MAX_MAPS:
             self._maps.popitem(last=False)[1].close()
         self._maps[key] = ring
         return ring
+
+    def release(self) -> None:
+        """Give back this reader's entries (its receiver closes: no writer waits for it).
+
+        The rings stay mapped: another thread may be copying out of one right now.
+        """
+        for ring in list(self._maps.values()):
+            ring.release()
 
     def forget(self, sender: int) -> None:
         """Unmap every ring of a process that is gone."""

@@ -241,6 +241,7 @@ class Writer:
         self._signed = 0 if self.auth is None else _SIGNED
         self.shm: SharedMemory | None = None  # see use_shm
         self._shm_gate: Callable[[], bool] = _never
+        self.shm_hold = True  # reliable: wait (bounded) for reliable readers of the ring
         self.shm_sent = 0  # messages sent as shared-memory descriptors
         register = getattr(transport, "register_writer", None)
         if register is not None:  # a transport that routes by name (Zenoh)
@@ -428,7 +429,7 @@ class Writer:
             and kind_value == _DATA
             and self._shm_gate()
         ):
-            descriptor = shm.put(self.sender, self.endpoint, payload)
+            descriptor = shm.put(self.sender, self.endpoint, payload, self.shm_hold)
             if descriptor is not None:  # else: no ring (no room): the bytes go as they are
                 payload, total, flags = descriptor, len(descriptor), flags | _SHM
                 self.shm_sent += 1
@@ -501,6 +502,7 @@ class Reader:
         self.duplicates = 0  # messages seen before (resent or replayed)
         self.stale = 0  # datagrams too old for their stream (replays), or stamped far off
         self.shm: RingReader | None = None  # maps publishers' rings (None: shm off here)
+        self.held: set[int] = set()  # topics a reliable subscription takes (see _from_shm)
         self.unmappable = 0  # shared-memory descriptors with shm off here
         self.retired = 0  # streams forgotten (silent, evicted, or their process said bye)
         self.streams: dict[tuple[int, int], StreamStats] = {}  # publishers: (process, endpoint)
@@ -688,7 +690,7 @@ class Reader:
                 self._jumped(sender, endpoint, stats)
         copied = 0
         if flags & _SHM:
-            resolved = self._from_shm(sender, endpoint, payload, stats)
+            resolved = self._from_shm(sender, endpoint, payload, stats, topic in self.held)
             if resolved is None:
                 return 0
             payload, flags = resolved, flags ^ _SHM
@@ -746,11 +748,20 @@ class Reader:
             out.append(_new_tuple(Delivery, fields))
 
     def _from_shm(
-        self, sender: int, endpoint: int, descriptor: Buffer | mmap.mmap, stats: StreamStats
+        self,
+        sender: int,
+        endpoint: int,
+        descriptor: Buffer | mmap.mmap,
+        stats: StreamStats,
+        hold: bool,
     ) -> memoryview | None:
-        """The message a shared-memory descriptor names; None (counted as lost) when gone."""
+        """The message a shared-memory descriptor names; None (counted as lost) when gone.
+
+        ``hold``: a reliable subscription of this process takes the topic, so the ring's
+        writer waits for this reader (see :mod:`rosl.bus.shm_ring`).
+        """
         shm = self.shm
-        data = None if shm is None else shm.read(sender, endpoint, descriptor)
+        data = None if shm is None else shm.read(sender, endpoint, descriptor, hold)
         if data is None:
             if shm is None:
                 self.unmappable += 1

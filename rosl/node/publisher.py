@@ -56,6 +56,7 @@ class Publisher:
         shm = getattr(participant.transport, "shm", None)
         if shm is not None and shm.host:
             self._writer.use_shm(_LocalSubscribers(node, topic, shm.host))
+            self._writer.shm_hold = qos.reliability is not ReliabilityPolicy.BEST_EFFORT
         if coalesce is None:
             coalesce = os.environ.get("ROSL_COALESCE", "").strip().lower() in ("1", "true", "yes")
         if coalesce:

@@ -1,0 +1,208 @@
+"""Reliable readers hold a shared-memory writer back, briefly, instead of losing messages.
+
+Real processes on the test's domain: a reader process takes the first message of a writer
+in this process, then waits for the test's word before it reads on, while the writer (a
+thread here) goes round its ring. A reliable reader keeps the writer waiting and gets every
+message; a best-effort reader, or a best-effort writer, loses the oldest (counted, never
+torn); a reader that stops reading, or is killed, holds the writer only briefly.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import threading
+from typing import TYPE_CHECKING
+
+import pytest
+
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.wire import Writer
+from tests.bus.helpers import Lines, wait_exit
+from tests.conftest import wait_until
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from rosl.bus.shm_ring import RingWriter
+    from tests.conftest import Processes
+
+TOPIC = "/shm_hold"
+SENDER, ENDPOINT = 0x5152, 3
+COUNT, SIZE = 120, 1_000_000  # slots of 1 MB and an eighth: 59 in a ring of 64 MiB
+LONG_NS = 60_000_000_000  # a hold no loaded machine outlasts (the writer waits for the test)
+
+READER = r"""
+import sys
+from rosl.bus.header import topic_hash
+from rosl.bus.multicast import Addressing, MulticastTransport
+from rosl.bus.transport import channel_of
+
+domain, count, size, hold = (int(a) for a in sys.argv[1:5])
+transport = MulticastTransport(Addressing(domain))
+receiver = transport.receiver()
+topic = topic_hash("/shm_hold")
+receiver.reader.wanted.add(topic)
+if hold:
+    receiver.reader.held.add(topic)  # a reliable subscription takes the topic
+receiver.join(channel_of(topic))
+print("ready", flush=True)
+out, got, torn = [], 0, 0
+def take():
+    global got, torn
+    for d in out:
+        index = int.from_bytes(bytes(d.payload[:4]), "little")
+        torn += bytes(d.payload) != index.to_bytes(4, "little") * (size // 4)
+        got += 1
+    out.clear()
+while not out:
+    receiver.poll(0.5, out)
+take()
+print("first", flush=True)
+if sys.stdin.readline().strip() == "stop":
+    sys.stdin.readline()  # reads nothing more, and holds its entry, until told to leave
+else:
+    idle = 0
+    while got + receiver.reader.lost() < count and idle < 20:
+        receiver.poll(0.25, out)
+        idle = 0 if out else idle + 1
+        take()
+print("got", got, "lost", receiver.reader.lost(), "torn", torn, flush=True)
+transport.close()
+"""
+
+
+def pattern(index: int, size: int) -> bytes:
+    return index.to_bytes(4, "little") * (size // 4)
+
+
+class Burst:
+    """A writer in this process, its first message sent; ``go`` sends the rest on a thread."""
+
+    def __init__(self, domain: int, hold: bool) -> None:
+        self.transport = MulticastTransport(Addressing(domain))
+        self.writer = Writer(self.transport, SENDER, ENDPOINT, TOPIC, "test/msg/Bytes")
+        self.writer.use_shm(lambda: True)
+        self.writer.shm_hold = hold
+        self.thread = threading.Thread(target=self._rest, daemon=True)
+
+    def first(self) -> RingWriter:
+        self.writer.send(pattern(0, SIZE))
+        assert self.transport.shm is not None
+        return self.transport.shm._rings[(SENDER, ENDPOINT)]
+
+    def _rest(self) -> None:
+        for index in range(1, COUNT):
+            self.writer.send(pattern(index, SIZE))
+
+    def go(self) -> None:
+        self.thread.start()
+
+    def done(self, timeout: float) -> bool:
+        self.thread.join(timeout)
+        return not self.thread.is_alive()
+
+    def close(self) -> None:
+        self.transport.close()
+
+
+def reader(processes: Processes, domain: int, hold: bool) -> tuple[subprocess.Popen[str], Lines]:
+    child = processes.python(
+        READER, str(domain), str(COUNT), str(SIZE), str(int(hold)), stdin=subprocess.PIPE
+    )
+    out = Lines(child.stdout)
+    assert out.wait_line("ready", 30.0), Lines(child.stderr).rest(2.0)
+    return child, out
+
+
+def tell(child: subprocess.Popen[str], word: str) -> None:
+    assert child.stdin is not None
+    child.stdin.write(word + "\n")
+    child.stdin.flush()
+
+
+def counts(out: Lines) -> tuple[int, int, int]:
+    line = out.wait_line("got ", 60.0)
+    assert line is not None
+    _, got, _, lost, _, torn = line.split()
+    return int(got), int(lost), int(torn)
+
+
+def first_heard(burst: Burst, child: subprocess.Popen[str], out: Lines) -> RingWriter:
+    ring = burst.first()
+    assert out.wait_line("first", 30.0), Lines(child.stderr).rest(2.0)
+    return ring
+
+
+@pytest.mark.parametrize(
+    ("reader_holds", "writer_holds"),
+    [(True, True), (False, True), (True, False)],
+    ids=["reliable", "best_effort_reader", "best_effort_writer"],
+)
+def test_a_reliable_reader_behind_by_more_than_a_ring_keeps_a_reliable_writer_waiting(
+    processes: Processes, domain_id: int, reader_holds: bool, writer_holds: bool
+) -> None:
+    # the reader holds at message 0 while the writer goes round its ring of 59 slots: a
+    # reliable reader keeps a reliable writer waiting (it waits for the test here, which
+    # says "go" only then) and gets all 120 messages; a best-effort reader is not waited
+    # for, a best-effort writer waits for nobody, and the reader loses the oldest, counted
+    reliable = reader_holds and writer_holds
+    child, out = reader(processes, domain_id, hold=reader_holds)
+    burst = Burst(domain_id, hold=writer_holds)
+    try:
+        ring = first_heard(burst, child, out)
+        ring.hold_ns = ring.max_wait_ns = LONG_NS
+        burst.go()
+        if reliable:
+            assert wait_until(lambda: ring.waited > 0, 30.0), "the writer never waited"
+            assert not burst.done(0.0), "the writer went round its reader"
+        else:
+            assert burst.done(60.0)
+        tell(child, "go")
+        got, lost, torn = counts(out)
+        assert burst.done(60.0)
+        assert torn == 0
+        if reliable:
+            assert (got, lost) == (COUNT, 0)
+            assert ring.waited_out == 0
+        else:
+            assert ring.waited == 0
+            assert lost >= COUNT - ring.slots
+            assert got + lost == COUNT
+        assert wait_exit(child, 30.0) == 0
+        assert ring._holders() == []  # the reader gave its entry back as it left
+    finally:
+        burst.close()
+
+
+def _stop(child: subprocess.Popen[str]) -> None:
+    tell(child, "stop")
+
+
+def _kill(child: subprocess.Popen[str]) -> None:
+    child.send_signal(signal.SIGKILL)
+    child.wait(30.0)
+
+
+@pytest.mark.parametrize("leave", [_stop, _kill], ids=["stops_reading", "killed"])
+def test_a_reader_that_stops_reading_holds_the_writer_at_most_once(
+    processes: Processes, domain_id: int, leave: Callable[[subprocess.Popen[str]], None]
+) -> None:
+    # with the usual hold (a reader that read nothing for 10 ms is not waited for), a reader
+    # that takes message 0 and then reads no more, alive or killed, costs the writer one
+    # wait at most (if the writer reached it within those 10 ms), never a wait run out
+    child, out = reader(processes, domain_id, hold=True)
+    burst = Burst(domain_id, hold=True)
+    try:
+        ring = first_heard(burst, child, out)
+        leave(child)
+        burst.go()
+        assert burst.done(60.0), "the writer kept waiting for a reader that reads no more"
+        assert ring.waited <= 1
+        assert ring.waited_out == 0
+        assert ring._holders(), "the reader's entry is still taken (it never gave it back)"
+    finally:
+        burst.close()
+        if child.poll() is None:
+            tell(child, "leave")
+            assert wait_exit(child, 30.0) == 0
