@@ -28,12 +28,17 @@ Reliable readers hold the writer back, briefly (as a DDS reliable writer blocks 
 readers, up to ``max_blocking_time``): a reader of a reliable subscription takes an entry in
 the readers' page (under ``flock``, so two readers never take one) and writes into it the
 number of the last message it is done with and when. A reliable writer about to begin a
-message that would push such a reader into dropping waits, in steps of 50 µs, while that
-reader read something in the last :data:`HOLD_NS` and for :data:`MAX_WAIT_NS` at most; then
-it writes on, and the reader loses what it did not read, counted as before. So a burst, or
-the page faults of a new ring's first lap, slows the publisher instead of costing messages,
-while a subscriber busy elsewhere (a long callback, a crash, an exit) costs it at most
-:data:`HOLD_NS` once. Best-effort publishers and subscribers never wait and never hold.
+message that would push such a reader into dropping waits (sleeping 50 µs, then longer, up
+to 400 µs) while that reader read something in the last :data:`HOLD_NS`, for
+:data:`MAX_WAIT_NS` at most; then it writes on, and the reader loses what it did not read,
+counted as before. So a burst, or the page faults of a new ring's first lap, slows the
+publisher instead of costing messages, while a subscriber busy elsewhere (a long callback, a
+crash, an exit) costs it at most :data:`HOLD_NS` once. A reader that keeps its writer waiting
+for more than :data:`BUDGET_NS` of a :data:`WINDOW_NS` is steadily slower than the writer (a
+keep-last subscriber whose callbacks cannot keep up): it is not waited for until it has
+caught up, so it costs the publisher a quarter of its time at most, not its pace (Fast DDS's
+data sharing, which waits for every reader, would set it). Best-effort publishers and
+subscribers never wait and never hold.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
@@ -87,6 +92,11 @@ FIRST_ENTRY = 4
 HOLD = 1  # an entry's flag: the reader is reliable (its writer waits for it, see below)
 HOLD_NS = 10_000_000  # a reader that read nothing for this long is not waited for
 MAX_WAIT_NS = 100_000_000  # one message waits at most this long (DDS's max_blocking_time)
+# a reader that kept its writer waiting for more than BUDGET_NS of a WINDOW_NS is steadily
+# slower than the writer, not behind by a burst: it is not waited for until it caught up
+WINDOW_NS, BUDGET_NS = 100_000_000, 25_000_000
+PAUSES = (50e-6, 100e-6, 200e-6, 400e-6)  # a waiting writer's sleeps, then the last again
+CLAIM_RETRY_NS = 1_000_000_000  # a reader that found no free entry looks again this late
 CLAIM_STALE_NS = 10_000_000_000  # an entry untouched this long is free for another reader
 _TOKENS = itertools.count(1)  # with the pid: who took a ring's entry
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
@@ -179,10 +189,15 @@ class RingWriter:
         self._held: list[int] = []  # entries of reliable readers (first words' indexes)
         self._changes = 0  # the readers' page's count of changes when _held was looked up
         self._next = 1
-        self.hold_ns = HOLD_NS  # (tests lengthen these two: a loaded machine's stalls)
+        self.hold_ns = HOLD_NS  # (tests lengthen these: a loaded machine's stalls)
         self.max_wait_ns = MAX_WAIT_NS
+        self.budget_ns = BUDGET_NS
+        self._spent: dict[int, list[int]] = {}  # entry -> [its window's start, ns waited in it]
+        self._excused: set[int] = set()  # entries that spent their budget, until they caught up
         self.waited = 0  # messages that waited for a reliable reader
         self.waited_out = 0  # ... until MAX_WAIT_NS, then overwrote what it had not read
+        self.excused = 0  # times a reader spent its budget (then it lost messages, counted)
+        self.waited_ns = 0  # time spent waiting, in all
         self.closed = False
 
     def make_room(self) -> None:
@@ -198,10 +213,14 @@ class RingWriter:
             self._held = self._holders()
         if self._held:
             need = self._next - self.slots + self._margin  # a reader's cursor must be this far
+            excused = self._excused
             for index in self._held:
                 if entries[index + 1] < need:
-                    self._wait(need)
-                    return
+                    if index not in excused:
+                        self._wait(need)
+                        return
+                elif excused:
+                    excused.discard(index)  # caught up: waited for again
 
     def put(self, payload: Buffer) -> bytes:
         """Write one message into the next slot; return its descriptor (for the datagram)."""
@@ -229,16 +248,27 @@ class RingWriter:
         ]
 
     def _wait(self, need: int) -> None:
-        """Wait while a reliable reader that is reading has not reached ``need``."""
-        entries, clock, hold_ns = self._entries, time.monotonic_ns, self.hold_ns
-        deadline = clock() + self.max_wait_ns
-        waits = self.waited
+        """Wait while a reliable reader that is reading, and within its budget, is behind.
+
+        The time waited is charged to each reader waited for; one that spends more than
+        ``budget_ns`` of a :data:`WINDOW_NS` is excused until it caught up (see make_room).
+        """
+        entries, clock, hold_ns, excused = (
+            self._entries,
+            time.monotonic_ns,
+            self.hold_ns,
+            self._excused,
+        )
+        last = clock()
+        deadline = last + self.max_wait_ns
+        waits, step = self.waited, 0
         while not self.closed:
             now = clock()
             behind = [
                 index
                 for index in self._held
-                if entries[index]
+                if index not in excused
+                and entries[index]
                 and entries[index + 1] < need
                 and now - entries[index + 2] < hold_ns
             ]
@@ -247,8 +277,23 @@ class RingWriter:
             if now >= deadline:
                 self.waited_out += 1
                 return
+            for index in behind:
+                self._charge(index, now, now - last)
+            self.waited_ns += now - last
+            last = now
             self.waited = waits + 1
-            time.sleep(50e-6)
+            time.sleep(PAUSES[min(step, len(PAUSES) - 1)])
+            step += 1
+
+    def _charge(self, index: int, now: int, spent: int) -> None:
+        """Count ``spent`` ns of waiting against a reader; excuse it past its budget."""
+        window = self._spent.get(index)
+        if window is None or now - window[0] >= WINDOW_NS:
+            window = self._spent[index] = [now, 0]
+        window[1] += spent
+        if window[1] > self.budget_ns:  # (the window stays: caught up, it gets the rest)
+            self._excused.add(index)
+            self.excused += 1
 
     @property
     def written(self) -> int:
@@ -303,11 +348,21 @@ class _Mapped:
         self.generations = self.view[GENERATIONS_AT : GENERATIONS_AT + 8 * slots].cast("Q")
         self.entry = -1  # our entry's first word in ``entries`` (-1: none taken)
         self.token = 0
+        self._refused = (0, 0)  # when no entry was free, and the page's count of changes then
         self._page: mmap.mmap | None = None
         self.entries: memoryview | None = None
 
     def claim(self, token: int, number: int) -> bool:
-        """Take a free entry for a reliable reader about to read ``number`` (False: none)."""
+        """Take a free entry for a reliable reader about to read ``number`` (False: none).
+
+        Where none was free, it looks again only once a reader left or a while later.
+        """
+        refused_at, changes = self._refused
+        if refused_at:
+            entries = self.entries
+            recent = time.monotonic_ns() - refused_at < CLAIM_RETRY_NS
+            if recent and (entries is None or entries[0] == changes):
+                return False
         try:
             if self.entries is None:
                 self._page = mmap.mmap(
@@ -317,6 +372,7 @@ class _Mapped:
             entries = self.entries
             fcntl.flock(self.fd, fcntl.LOCK_EX)
         except (OSError, ValueError):
+            self._refused = (time.monotonic_ns(), 0)
             return False  # (a ring file we may only read: we read without holding it)
         try:
             now = time.monotonic_ns()
@@ -329,6 +385,7 @@ class _Mapped:
                     entries[0] += 1  # (the writer looks again)
                     self.entry, self.token = index, token
                     return True
+            self._refused = (now, entries[0])
             return False
         finally:
             fcntl.flock(self.fd, fcntl.LOCK_UN)
@@ -337,7 +394,9 @@ class _Mapped:
         """Give our entry back (its writer stops waiting for us at once)."""
         entries, entry = self.entries, self.entry
         self.entry = -1
-        if entries is None or entry < 0 or entries[entry] != self.token:
+        if entries is None or entry < 0 or self.token >> 32 != os.getpid():
+            return  # (a forked child leaves its parent's entry alone)
+        if entries[entry] != self.token:
             return
         with contextlib.suppress(OSError):
             fcntl.flock(self.fd, fcntl.LOCK_EX)
@@ -450,7 +509,12 @@ class RingReader:
         if hold:
             data = self._read(ring, number, size)
             entries = ring.entries
-            if entries is None or ring.entry < 0 or entries[ring.entry] != ring.token:
+            if (
+                entries is None
+                or ring.entry < 0
+                or entries[ring.entry] != ring.token
+                or ring.token >> 32 != os.getpid()  # (a forked child: the entry is its parent's)
+            ):
                 if not ring.claim(next(_TOKENS) | os.getpid() << 32, number):
                     return data
                 entries = ring.entries

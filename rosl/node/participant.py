@@ -196,18 +196,11 @@ class Participant:
         """Rebuild what takes a topic's deliveries at once (under ``_lock``)."""
         self._takers = {topic: tuple(map(_taker, handlers))
                         for topic, handlers in self._handlers.items()}  # fmt: skip
-        self.rehold()
-
-    def rehold(self) -> None:
-        """Say again which topics this process's shared-memory reads hold their writers for.
-
-        A topic is held while a subscription to it is reliable and keeping up (its
-        ``holding``; see :mod:`rosl.bus.shm_ring`). Called on the polling thread too, so it
-        reads a snapshot of the handlers and takes no lock.
-        """
+        # topics a reliable subscription takes: shared-memory writers wait for our reads
+        # (see rosl.bus.shm_ring)
         self.reader.held = {
             topic
-            for topic, handlers in list(self._handlers.items())
+            for topic, handlers in self._handlers.items()
             if any(getattr(handler, "holding", False) for handler in handlers)
         }
 

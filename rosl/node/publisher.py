@@ -93,7 +93,13 @@ class Publisher:
         return self.topic
 
     def publish(self, msg: Message | bytes | bytearray | memoryview) -> None:
-        """Send one message (or already-serialized CDR bytes); never blocks on subscribers."""
+        """Send one message (or already-serialized CDR bytes).
+
+        It blocks on subscribers only as a DDS reliable writer does: a reliable publisher
+        of a large message through shared memory waits (100 ms at most) for a reliable
+        subscription of this host that is reading but about to lose messages (see
+        :mod:`rosl.bus.shm_ring`).
+        """
         if type(msg) is self.msg_type:  # the common case, checked no further
             data: bytes | memoryview = self._serialize_own(msg)  # bytes or a view: any sends
         else:

@@ -131,16 +131,12 @@ class Subscription(Queued):
         self.incompatible = 0  # messages of publishers whose QoS does not match (dropped)
         self.expired = 0  # messages older than their publisher's lifespan (dropped)
         self._words = qos.words(subscription=True)
-        # a reliable subscription that keeps up (its queue did not overflow since it was last
-        # empty) is held for: a publisher on this host waits, briefly, before its shared
-        # memory drops messages we have not read (see rosl.bus.shm_ring); one that fell
-        # behind would drop them from its queue anyway, so it holds nobody up
-        self.reliable = qos.reliability in (
+        # reliable: a publisher on this host waits, briefly, before its shared memory drops
+        # messages we have not read yet (see rosl.bus.shm_ring)
+        self.holding = qos.reliability in (
             ReliabilityPolicy.RELIABLE,
             ReliabilityPolicy.BEST_AVAILABLE,
         )
-        self.holding = self.reliable
-        self._behind = False  # reliable, and fell behind: holds again once its queue is empty
         # for the deadline and liveliness (see qos_watch): arrival times on the monotonic clock
         self.last_arrival_ns: int | None = None
         self.peer_seen: dict[tuple[int, int], int] | None = None  # per publisher, when tracked
@@ -186,10 +182,6 @@ class Subscription(Queued):
         queue = self._queue
         if len(queue) == queue.maxlen:
             self.dropped += 1
-            if self.holding:
-                self._hold(False)
-        elif self._behind and not queue:
-            self._hold(True)
         queue.append(delivery)
 
     def deliver_all(self, deliveries: list[Delivery]) -> None:
@@ -207,16 +199,7 @@ class Subscription(Queued):
         pushed_out = len(queue) + count - self._depth  # (the oldest go, new ones too if many)
         if pushed_out > 0:
             self.dropped += pushed_out
-            if self.holding:
-                self._hold(False)
-        elif self._behind and not queue:
-            self._hold(True)
         queue.extend(deliveries)
-
-    def _hold(self, keeping_up: bool) -> None:
-        """A reliable subscription fell behind, or caught up: say so to shared memory."""
-        self.holding, self._behind = keeping_up, not keeping_up
-        self.node.participant.rehold()
 
     def _seen(self, delivery: Delivery, now_ns: int) -> None:
         seen = self.peer_seen

@@ -4,14 +4,19 @@ Real processes on the test's domain: a reader process takes the first message of
 in this process, then waits for the test's word before it reads on, while the writer (a
 thread here) goes round its ring. A reliable reader keeps the writer waiting and gets every
 message; a best-effort reader, or a best-effort writer, loses the oldest (counted, never
-torn); a reader that stops reading, or is killed, holds the writer only briefly.
+torn); a reader that stops reading, or is killed, holds the writer only briefly, and one
+that keeps it waiting past its budget is not waited for.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
 import signal
 import subprocess
 import threading
+import time
+from array import array
 from typing import TYPE_CHECKING
 
 import pytest
@@ -22,7 +27,7 @@ from tests.bus.helpers import Lines, wait_exit
 from tests.conftest import wait_until
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
 
     from rosl.bus.shm_ring import RingWriter
     from tests.conftest import Processes
@@ -151,7 +156,7 @@ def test_a_reliable_reader_behind_by_more_than_a_ring_keeps_a_reliable_writer_wa
     burst = Burst(domain_id, hold=writer_holds)
     try:
         ring = first_heard(burst, child, out)
-        ring.hold_ns = ring.max_wait_ns = LONG_NS
+        ring.hold_ns = ring.max_wait_ns = ring.budget_ns = LONG_NS
         burst.go()
         if reliable:
             assert wait_until(lambda: ring.waited > 0, 30.0), "the writer never waited"
@@ -171,6 +176,32 @@ def test_a_reliable_reader_behind_by_more_than_a_ring_keeps_a_reliable_writer_wa
             assert got + lost == COUNT
         assert wait_exit(child, 30.0) == 0
         assert ring._holders() == []  # the reader gave its entry back as it left
+    finally:
+        burst.close()
+
+
+def test_a_reader_that_keeps_the_writer_waiting_past_its_budget_is_not_waited_for(
+    processes: Processes, domain_id: int
+) -> None:
+    # a reliable reader that reads no more (but read recently, as far as the writer can
+    # tell: a long hold) is steadily slower than its writer, not behind by a burst: once it
+    # cost the writer its budget (25 ms of waits within 100 ms), the writer goes on without
+    # it, and the reader loses the oldest, counted
+    child, out = reader(processes, domain_id, hold=True)
+    burst = Burst(domain_id, hold=True)
+    try:
+        ring = first_heard(burst, child, out)
+        ring.hold_ns = ring.max_wait_ns = LONG_NS
+        burst.go()
+        assert burst.done(60.0), "the writer kept waiting past the reader's budget"
+        assert ring.waited >= 1
+        assert ring.excused == 1
+        assert ring.waited_out == 0
+        tell(child, "go")
+        got, lost, torn = counts(out)
+        assert (torn, got + lost) == (0, COUNT)
+        assert lost >= COUNT - ring.slots
+        assert wait_exit(child, 30.0) == 0
     finally:
         burst.close()
 
@@ -206,3 +237,127 @@ def test_a_reader_that_stops_reading_holds_the_writer_at_most_once(
         if child.poll() is None:
             tell(child, "leave")
             assert wait_exit(child, 30.0) == 0
+
+
+# --- one ring in this process: the readers' page itself -----------------------------------
+
+
+@pytest.fixture
+def ring_path(request: pytest.FixtureRequest) -> Iterator[str]:
+    from rosl.bus.shm import DIRECTORY
+
+    path = os.path.join(DIRECTORY, f"rosl-test-hold-{os.getpid()}-{request.node.name[:40]}")
+    yield path
+    with contextlib.suppress(OSError):
+        os.unlink(path)
+
+
+def small_ring(path: str) -> tuple[RingWriter, Callable[[int], bytes]]:
+    """A ring of 16 slots of 4 KiB, and a function writing message ``n`` into it."""
+    from rosl.bus.shm import this_process
+    from rosl.bus.shm_ring import RingWriter
+
+    writer = RingWriter(path, this_process(), 1, 16, 4096)
+
+    def put(number: int) -> bytes:
+        writer.make_room()
+        return writer.put(pattern(number, 4096))
+
+    return writer, put
+
+
+def test_an_excused_reader_is_waited_for_again_once_it_caught_up(ring_path: str) -> None:
+    from rosl.bus.shm_ring import RingReader
+
+    writer, put = small_ring(ring_path)
+    try:
+        reader = RingReader(lambda *_: ring_path)
+        sent = [put(1)]
+        assert reader.read(SENDER, ENDPOINT, sent[0], hold=True) is not None
+        writer.hold_ns, writer.budget_ns = LONG_NS, 0  # any wait spends the budget
+        sent += [put(n) for n in range(2, 18)]  # 17 would push the reader into dropping
+        assert (writer.waited, writer.excused, writer.waited_out) == (1, 1, 0)
+        got = [reader.read(SENDER, ENDPOINT, d, hold=True) for d in sent[1:]]
+        assert sum(g is not None for g in got) == 15  # 2 was dropped to make room
+        sent.append(put(18))  # caught up: no longer excused
+        assert writer._excused == set()
+        writer.budget_ns, writer.max_wait_ns = LONG_NS, 1_000_000
+        for number in range(19, 34):  # 33 pushes it again: waited for (1 ms), not excused
+            sent.append(put(number))
+        assert (writer.excused, writer.waited_out) == (1, 1)
+    finally:
+        writer.close()
+
+
+def test_an_entry_whose_reader_read_nothing_for_10_s_goes_to_the_next_reader(
+    ring_path: str,
+) -> None:
+    from rosl.bus.shm_ring import CLAIM_STALE_NS, RingReader
+
+    writer, put = small_ring(ring_path)
+    try:
+        first, second = (RingReader(lambda *_: ring_path) for _ in range(2))
+        descriptor = put(1)
+        assert first.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
+        (mapped,) = first._maps.values()
+        assert mapped.entries is not None
+        taken = mapped.entry
+        mapped.entries[taken + 2] = time.monotonic_ns() - CLAIM_STALE_NS - 1  # long idle
+        assert second.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
+        (other,) = second._maps.values()
+        assert other.entry == taken  # the idle reader's entry, not a free one
+        assert first.read(SENDER, ENDPOINT, put(2), hold=True) is not None
+        assert mapped.entry not in (-1, taken)  # it took another when it read again
+        assert sorted(writer._holders()) == sorted([taken, mapped.entry])
+    finally:
+        writer.close()
+
+
+def test_a_forked_child_leaves_its_parents_entry_alone(ring_path: str) -> None:
+    from rosl.bus.shm_ring import RingReader
+
+    writer, put = small_ring(ring_path)
+    try:
+        reader = RingReader(lambda *_: ring_path)
+        assert reader.read(SENDER, ENDPOINT, put(1), hold=True) is not None
+        holders = writer._holders()
+        assert len(holders) == 1
+        pid = os.fork()
+        if pid == 0:  # the child: gives back what it holds (nothing of its own), and goes
+            reader.release()
+            os._exit(0)
+        _, status = os.waitpid(pid, 0)
+        assert os.waitstatus_to_exitcode(status) == 0
+        assert writer._holders() == holders
+    finally:
+        writer.close()
+
+
+def test_a_reader_finding_no_free_entry_looks_again_only_after_a_change(ring_path: str) -> None:
+    import mmap
+
+    from rosl.bus.shm_ring import ENTRIES, FIRST_ENTRY, PAGE, RingReader, readers_at
+
+    writer, put = small_ring(ring_path)
+    fd = os.open(ring_path, os.O_RDWR)
+    page = mmap.mmap(fd, PAGE, offset=readers_at(16))
+    entries = memoryview(page).cast("Q")
+    try:
+        now = time.monotonic_ns()
+        for index in range(FIRST_ENTRY, 4 * ENTRIES, 4):  # every entry taken, all reading
+            entries[index : index + 4] = array("Q", [index, 0, now, 1])
+        reader = RingReader(lambda *_: ring_path)
+        assert reader.read(SENDER, ENDPOINT, put(1), hold=True) is not None  # read, unheld
+        (mapped,) = reader._maps.values()
+        assert mapped.entry == -1
+        entries[FIRST_ENTRY] = 0  # one is free, but the page's count of changes says nothing
+        assert reader.read(SENDER, ENDPOINT, put(2), hold=True) is not None
+        assert mapped.entry == -1  # not looked at again
+        entries[0] += 1  # (as a reader leaving counts it)
+        assert reader.read(SENDER, ENDPOINT, put(3), hold=True) is not None
+        assert mapped.entry == FIRST_ENTRY
+    finally:
+        entries.release()
+        page.close()
+        os.close(fd)
+        writer.close()
