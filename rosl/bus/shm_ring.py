@@ -33,11 +33,12 @@ to 400 µs) while that reader read something in the last :data:`HOLD_NS`, for
 :data:`MAX_WAIT_NS` at most; then it writes on, and the reader loses what it did not read,
 counted as before. So a burst, or the page faults of a new ring's first lap, slows the
 publisher instead of costing messages, while a subscriber busy elsewhere (a long callback, a
-crash, an exit) costs it at most :data:`HOLD_NS` once. A reader that keeps its writer waiting
-for more than :data:`BUDGET_NS` of a :data:`WINDOW_NS` is steadily slower than the writer (a
-keep-last subscriber whose callbacks cannot keep up): it is not waited for until it has
-caught up, so it costs the publisher a quarter of its time at most, not its pace (Fast DDS's
-data sharing, which waits for every reader, would set it). Best-effort publishers and
+crash, an exit) costs it at most :data:`HOLD_NS` once. Each reader has a credit of waiting,
+:data:`BUDGET_NS`, refilled at that much per :data:`WINDOW_NS`: one that spends it is
+steadily slower than the writer (a keep-last subscriber whose callbacks cannot keep up), not
+behind by a burst, and is not waited for until it has caught up; so it costs the publisher a
+quarter of its time, and a credit, at most, but never sets its pace (Fast DDS's data
+sharing, which waits for every reader, would). Best-effort publishers and
 subscribers never wait and never hold.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
@@ -59,7 +60,6 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import itertools
 import mmap
 import os
 import stat
@@ -92,17 +92,22 @@ FIRST_ENTRY = 4
 HOLD = 1  # an entry's flag: the reader is reliable (its writer waits for it, see below)
 HOLD_NS = 10_000_000  # a reader that read nothing for this long is not waited for
 MAX_WAIT_NS = 100_000_000  # one message waits at most this long (DDS's max_blocking_time)
-# a reader that kept its writer waiting for more than BUDGET_NS of a WINDOW_NS is steadily
-# slower than the writer, not behind by a burst: it is not waited for until it caught up
+# a reader's credit of waiting, refilled at BUDGET_NS per WINDOW_NS: one that spends it is
+# steadily slower than the writer, not behind by a burst, and is not waited for until it
+# caught up
 WINDOW_NS, BUDGET_NS = 100_000_000, 25_000_000
 PAUSES = (50e-6, 100e-6, 200e-6, 400e-6)  # a waiting writer's sleeps, then the last again
 CLAIM_RETRY_NS = 1_000_000_000  # a reader that found no free entry looks again this late
 CLAIM_STALE_NS = 10_000_000_000  # an entry untouched this long is free for another reader
-_TOKENS = itertools.count(1)  # with the pid: who took a ring's entry
 MAX_MAPS = 64  # rings a reader keeps mapped at once (least recently used go first)
 POOLED = 8  # buffers kept per ring size beyond those one drain's copies take
 DRAIN_BYTES = 1024 * 1024  # copies one drain of a receiver makes at most (see wire.py)
 _UNUSED = 3  # sys.getrefcount of a pooled buffer nobody holds: the pool, the loop, the call
+
+
+def _token() -> int:
+    """Who takes a ring's entry: this pid, and 32 random bits (other pid namespaces' pids)."""
+    return os.getpid() << 32 | int.from_bytes(os.urandom(4), "little") | 1
 
 
 def _round_up(value: int, step: int) -> int:
@@ -192,8 +197,9 @@ class RingWriter:
         self.hold_ns = HOLD_NS  # (tests lengthen these: a loaded machine's stalls)
         self.max_wait_ns = MAX_WAIT_NS
         self.budget_ns = BUDGET_NS
-        self._spent: dict[int, list[int]] = {}  # entry -> [its window's start, ns waited in it]
+        self._credit: dict[int, list[int]] = {}  # entry -> [ns it may still cost, as of when]
         self._excused: set[int] = set()  # entries that spent their budget, until they caught up
+        self._tokens: dict[int, int] = {}  # entry -> the token of the reader it was charged to
         self.waited = 0  # messages that waited for a reliable reader
         self.waited_out = 0  # ... until MAX_WAIT_NS, then overwrote what it had not read
         self.excused = 0  # times a reader spent its budget (then it lost messages, counted)
@@ -241,17 +247,24 @@ class RingWriter:
         """Where the entries of reliable readers are (their first word's index)."""
         entries = self._entries
         self._changes = entries[0]
-        return [
+        held = [
             index
             for index in range(FIRST_ENTRY, 4 * ENTRIES, 4)
             if entries[index] and entries[index + 3] & HOLD
         ]
+        tokens = {index: entries[index] for index in held}
+        for index, token in list(self._tokens.items()):  # another reader: a clean slate
+            if tokens.get(index) != token:
+                self._credit.pop(index, None)
+                self._excused.discard(index)
+        self._tokens = tokens
+        return held
 
     def _wait(self, need: int) -> None:
         """Wait while a reliable reader that is reading, and within its budget, is behind.
 
         The time waited is charged to each reader waited for; one that spends more than
-        ``budget_ns`` of a :data:`WINDOW_NS` is excused until it caught up (see make_room).
+        its credit is excused until it caught up (see make_room and _charge).
         """
         entries, clock, hold_ns, excused = (
             self._entries,
@@ -262,8 +275,15 @@ class RingWriter:
         last = clock()
         deadline = last + self.max_wait_ns
         waits, step = self.waited, 0
+        behind: list[int] = []
         while not self.closed:
             now = clock()
+            if behind:  # the pause just slept was for these readers
+                spent = now - last
+                self.waited_ns += spent
+                for index in behind:
+                    self._charge(index, now, spent)
+            last = now
             behind = [
                 index
                 for index in self._held
@@ -277,21 +297,25 @@ class RingWriter:
             if now >= deadline:
                 self.waited_out += 1
                 return
-            for index in behind:
-                self._charge(index, now, now - last)
-            self.waited_ns += now - last
-            last = now
             self.waited = waits + 1
             time.sleep(PAUSES[min(step, len(PAUSES) - 1)])
             step += 1
 
     def _charge(self, index: int, now: int, spent: int) -> None:
-        """Count ``spent`` ns of waiting against a reader; excuse it past its budget."""
-        window = self._spent.get(index)
-        if window is None or now - window[0] >= WINDOW_NS:
-            window = self._spent[index] = [now, 0]
-        window[1] += spent
-        if window[1] > self.budget_ns:  # (the window stays: caught up, it gets the rest)
+        """Count ``spent`` ns of waiting against a reader; excuse it once it is past its budget.
+
+        Each reader's credit fills at ``budget_ns`` per :data:`WINDOW_NS`, up to
+        ``budget_ns``: any stretch of time costs the writer at most that much and a quarter.
+        """
+        budget = self.budget_ns
+        credit = self._credit.get(index)
+        if credit is None:
+            credit = self._credit[index] = [budget, now]
+        else:
+            credit[0] = min(budget, credit[0] + (now - credit[1]) * budget // WINDOW_NS)
+            credit[1] = now
+        credit[0] -= spent
+        if credit[0] < 0:
             self._excused.add(index)
             self.excused += 1
 
@@ -515,7 +539,7 @@ class RingReader:
                 or entries[ring.entry] != ring.token
                 or ring.token >> 32 != os.getpid()  # (a forked child: the entry is its parent's)
             ):
-                if not ring.claim(next(_TOKENS) | os.getpid() << 32, number):
+                if not ring.claim(_token(), number):
                     return data
                 entries = ring.entries
                 assert entries is not None

@@ -272,6 +272,9 @@ def echo(
         msg_type, topic, lambda m, info: inbox.append((m, info)), qos, raw=options.raw
     )
     subscription.log_loss = False  # echo says "A message was lost!!!" itself, as ros2 does
+    subscription.log_mismatch = False  # (a publisher of another type: refused below, one line)
+    subscription.holding = False  # a view never slows what it shows (see rosl.bus.shm_ring)
+    node.participant.rehold()
     import rosl
 
     executor = rosl.SingleThreadedExecutor()

@@ -196,13 +196,19 @@ class Participant:
         """Rebuild what takes a topic's deliveries at once (under ``_lock``)."""
         self._takers = {topic: tuple(map(_taker, handlers))
                         for topic, handlers in self._handlers.items()}  # fmt: skip
-        # topics a reliable subscription takes: shared-memory writers wait for our reads
-        # (see rosl.bus.shm_ring)
-        self.reader.held = {
-            topic
-            for topic, handlers in self._handlers.items()
-            if any(getattr(handler, "holding", False) for handler in handlers)
-        }
+        self.rehold()
+
+    def rehold(self) -> None:
+        """Say again which topics a holding subscription takes (after one changed its mind).
+
+        Their shared-memory writers wait for this process's reads (see rosl.bus.shm_ring).
+        """
+        with self._lock:
+            self.reader.held = {
+                topic
+                for topic, handlers in self._handlers.items()
+                if any(getattr(handler, "holding", False) for handler in handlers)
+            }
 
     def _limit_reads(self) -> None:
         """Per channel, the shallowest queue its messages go to: what one poll should read.

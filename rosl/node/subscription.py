@@ -118,6 +118,7 @@ class Subscription(Queued):
         self._streams = participant.reader.streams  # sequence bookkeeping per publisher
         self._lost_told = 0  # the loss already reported in the log
         self.log_loss = True  # False for tools that report loss in their own words (echo)
+        self.log_mismatch = True  # False for tools that refuse another type themselves (echo)
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
         self._depth = queue_depth(qos)
@@ -322,7 +323,11 @@ class Subscription(Queued):
 
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1
-        if delivery.sender in self._warned or len(self._warned) >= MAX_PEERS:
+        if (
+            not self.log_mismatch
+            or delivery.sender in self._warned
+            or len(self._warned) >= MAX_PEERS
+        ):
             return
         self._warned.add(delivery.sender)
         found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)

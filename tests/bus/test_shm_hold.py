@@ -29,7 +29,9 @@ from tests.conftest import wait_until
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
 
-    from rosl.bus.shm_ring import RingWriter
+    from rosl.bus.shm_ring import RingReader, RingWriter
+
+    Small = tuple[RingWriter, Callable[[int], bytes]]
     from tests.conftest import Processes
 
 TOPIC = "/shm_hold"
@@ -252,101 +254,121 @@ def ring_path(request: pytest.FixtureRequest) -> Iterator[str]:
         os.unlink(path)
 
 
-def small_ring(path: str) -> tuple[RingWriter, Callable[[int], bytes]]:
+@pytest.fixture
+def small(ring_path: str) -> Iterator[Small]:
     """A ring of 16 slots of 4 KiB, and a function writing message ``n`` into it."""
     from rosl.bus.shm import this_process
     from rosl.bus.shm_ring import RingWriter
 
-    writer = RingWriter(path, this_process(), 1, 16, 4096)
+    writer = RingWriter(ring_path, this_process(), 1, 16, 4096)
 
     def put(number: int) -> bytes:
         writer.make_room()
         return writer.put(pattern(number, 4096))
 
-    return writer, put
+    yield writer, put
+    writer.close()
 
 
-def test_an_excused_reader_is_waited_for_again_once_it_caught_up(ring_path: str) -> None:
+def reader_of(path: str) -> RingReader:
     from rosl.bus.shm_ring import RingReader
 
-    writer, put = small_ring(ring_path)
-    try:
-        reader = RingReader(lambda *_: ring_path)
-        sent = [put(1)]
-        assert reader.read(SENDER, ENDPOINT, sent[0], hold=True) is not None
-        writer.hold_ns, writer.budget_ns = LONG_NS, 0  # any wait spends the budget
-        sent += [put(n) for n in range(2, 18)]  # 17 would push the reader into dropping
-        assert (writer.waited, writer.excused, writer.waited_out) == (1, 1, 0)
-        got = [reader.read(SENDER, ENDPOINT, d, hold=True) for d in sent[1:]]
-        assert sum(g is not None for g in got) == 15  # 2 was dropped to make room
-        sent.append(put(18))  # caught up: no longer excused
-        assert writer._excused == set()
-        writer.budget_ns, writer.max_wait_ns = LONG_NS, 1_000_000
-        for number in range(19, 34):  # 33 pushes it again: waited for (1 ms), not excused
-            sent.append(put(number))
-        assert (writer.excused, writer.waited_out) == (1, 1)
-    finally:
-        writer.close()
+    return RingReader(lambda *_: path)
+
+
+def holding_first(path: str, put: Callable[[int], bytes]) -> tuple[RingReader, list[bytes]]:
+    """A reader of the ring at ``path`` that took message 1 as a reliable reader does."""
+    reader = reader_of(path)
+    sent = [put(1)]
+    assert reader.read(SENDER, ENDPOINT, sent[0], hold=True) is not None
+    return reader, sent
+
+
+def test_an_excused_reader_is_waited_for_again_once_it_caught_up(
+    ring_path: str, small: Small
+) -> None:
+    writer, put = small
+    reader, sent = holding_first(ring_path, put)
+    writer.hold_ns, writer.budget_ns = LONG_NS, 0  # any wait spends the budget
+    sent += [put(n) for n in range(2, 18)]  # 17 would push the reader into dropping
+    assert (writer.waited, writer.excused, writer.waited_out) == (1, 1, 0)
+    got = [reader.read(SENDER, ENDPOINT, d, hold=True) for d in sent[1:]]
+    assert sum(g is not None for g in got) == 15  # 2 was dropped to make room
+    sent.append(put(18))  # caught up: no longer excused
+    assert writer._excused == set()
+    writer.budget_ns, writer.max_wait_ns = LONG_NS, 1_000_000
+    for number in range(19, 34):  # 33 pushes it again: waited for (1 ms), not excused
+        sent.append(put(number))
+    assert (writer.excused, writer.waited_out) == (1, 1)
 
 
 def test_an_entry_whose_reader_read_nothing_for_10_s_goes_to_the_next_reader(
-    ring_path: str,
+    ring_path: str, small: Small
 ) -> None:
-    from rosl.bus.shm_ring import CLAIM_STALE_NS, RingReader
+    from rosl.bus.shm_ring import CLAIM_STALE_NS
 
-    writer, put = small_ring(ring_path)
-    try:
-        first, second = (RingReader(lambda *_: ring_path) for _ in range(2))
-        descriptor = put(1)
-        assert first.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
-        (mapped,) = first._maps.values()
-        assert mapped.entries is not None
-        taken = mapped.entry
-        mapped.entries[taken + 2] = time.monotonic_ns() - CLAIM_STALE_NS - 1  # long idle
-        assert second.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
-        (other,) = second._maps.values()
-        assert other.entry == taken  # the idle reader's entry, not a free one
-        assert first.read(SENDER, ENDPOINT, put(2), hold=True) is not None
-        assert mapped.entry not in (-1, taken)  # it took another when it read again
-        assert sorted(writer._holders()) == sorted([taken, mapped.entry])
-    finally:
-        writer.close()
+    writer, put = small
+    first, second = (reader_of(ring_path) for _ in range(2))
+    descriptor = put(1)
+    assert first.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
+    (mapped,) = first._maps.values()
+    assert mapped.entries is not None
+    taken = mapped.entry
+    mapped.entries[taken + 2] = time.monotonic_ns() - CLAIM_STALE_NS - 1  # long idle
+    assert second.read(SENDER, ENDPOINT, descriptor, hold=True) is not None
+    (other,) = second._maps.values()
+    assert other.entry == taken  # the idle reader's entry, not a free one
+    assert first.read(SENDER, ENDPOINT, put(2), hold=True) is not None
+    assert mapped.entry not in (-1, taken)  # it took another when it read again
+    assert sorted(writer._holders()) == sorted([taken, mapped.entry])
 
 
-def test_a_forked_child_leaves_its_parents_entry_alone(ring_path: str) -> None:
-    from rosl.bus.shm_ring import RingReader
-
-    writer, put = small_ring(ring_path)
-    try:
-        reader = RingReader(lambda *_: ring_path)
-        assert reader.read(SENDER, ENDPOINT, put(1), hold=True) is not None
-        holders = writer._holders()
-        assert len(holders) == 1
-        pid = os.fork()
-        if pid == 0:  # the child: gives back what it holds (nothing of its own), and goes
+def test_a_forked_child_leaves_its_parents_entry_alone(ring_path: str, small: Small) -> None:
+    writer, put = small
+    reader = reader_of(ring_path)
+    assert reader.read(SENDER, ENDPOINT, put(1), hold=True) is not None
+    holders = writer._holders()
+    assert len(holders) == 1
+    (mapped,) = reader._maps.values()
+    assert mapped.entries is not None
+    before = list(mapped.entries[holders[0] : holders[0] + 3])  # token, cursor, stamp
+    pid = os.fork()
+    if pid == 0:  # the child: reads (an entry of its own), gives back what it holds, goes
+        code = 1
+        try:
+            reader.read(SENDER, ENDPOINT, put(2), hold=True)
+            code = 0 if mapped.entry not in (-1, holders[0]) else 2
             reader.release()
-            os._exit(0)
-        _, status = os.waitpid(pid, 0)
-        assert os.waitstatus_to_exitcode(status) == 0
-        assert writer._holders() == holders
-    finally:
-        writer.close()
+        finally:
+            os._exit(code)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    assert writer._holders() == holders
+    assert list(mapped.entries[holders[0] : holders[0] + 3]) == before
 
 
-def test_a_reader_finding_no_free_entry_looks_again_only_after_a_change(ring_path: str) -> None:
+def test_a_reader_finding_no_free_entry_looks_again_only_after_a_change(
+    ring_path: str, small: Small, monkeypatch: pytest.MonkeyPatch
+) -> None:
     import mmap
 
-    from rosl.bus.shm_ring import ENTRIES, FIRST_ENTRY, PAGE, RingReader, readers_at
+    from rosl.bus import shm_ring
+    from rosl.bus.shm_ring import ENTRIES, FIRST_ENTRY, PAGE, readers_at
 
-    writer, put = small_ring(ring_path)
-    fd = os.open(ring_path, os.O_RDWR)
-    page = mmap.mmap(fd, PAGE, offset=readers_at(16))
-    entries = memoryview(page).cast("Q")
-    try:
+    # (however slow the machine: no look again for time alone, no entry idle long enough)
+    monkeypatch.setattr(shm_ring, "CLAIM_RETRY_NS", LONG_NS)
+    monkeypatch.setattr(shm_ring, "CLAIM_STALE_NS", LONG_NS)
+
+    _, put = small
+    with (
+        open(ring_path, "r+b") as handle,
+        mmap.mmap(handle.fileno(), PAGE, offset=readers_at(16)) as page,
+        memoryview(page).cast("Q") as entries,
+    ):
         now = time.monotonic_ns()
         for index in range(FIRST_ENTRY, 4 * ENTRIES, 4):  # every entry taken, all reading
             entries[index : index + 4] = array("Q", [index, 0, now, 1])
-        reader = RingReader(lambda *_: ring_path)
+        reader = reader_of(ring_path)
         assert reader.read(SENDER, ENDPOINT, put(1), hold=True) is not None  # read, unheld
         (mapped,) = reader._maps.values()
         assert mapped.entry == -1
@@ -356,8 +378,54 @@ def test_a_reader_finding_no_free_entry_looks_again_only_after_a_change(ring_pat
         entries[0] += 1  # (as a reader leaving counts it)
         assert reader.read(SENDER, ENDPOINT, put(3), hold=True) is not None
         assert mapped.entry == FIRST_ENTRY
-    finally:
-        entries.release()
-        page.close()
-        os.close(fd)
-        writer.close()
+
+
+def test_every_pause_of_a_wait_is_charged_to_the_reader_it_waited_for(
+    ring_path: str, small: Small
+) -> None:
+    # the reader catches up during the writer's first pause (50 us at least): that pause,
+    # the last of the wait, counts against the reader's credit too
+    writer, put = small
+    reader, sent = holding_first(ring_path, put)
+    writer.hold_ns = writer.max_wait_ns = LONG_NS
+    sent += [put(n) for n in range(2, 17)]  # the next would push the reader into dropping
+
+    def catch_up() -> None:
+        assert wait_until(lambda: writer.waited == 1, 30.0)
+        for descriptor in sent[1:]:
+            reader.read(SENDER, ENDPOINT, descriptor, hold=True)
+
+    helper = threading.Thread(target=catch_up)
+    helper.start()
+    sent.append(put(17))  # waits until the helper read on
+    helper.join(30.0)
+    assert (writer.waited, writer.waited_out, writer.excused) == (1, 0, 0)
+    assert writer.waited_ns >= 50_000
+    ((credit, _),) = writer._credit.values()
+    assert credit <= writer.budget_ns - 50_000
+
+
+def test_a_reader_taking_an_entry_over_starts_with_a_clean_slate(
+    ring_path: str, small: Small
+) -> None:
+    # a reader excused (its credit spent) leaves; the next reader in its entry is waited for
+
+    writer, put = small
+    first, sent = holding_first(ring_path, put)
+    writer.hold_ns, writer.budget_ns = LONG_NS, 0
+    sent += [put(n) for n in range(2, 18)]
+    assert writer.excused == 1
+    (taken,) = writer._excused
+    first.release()
+    second = reader_of(ring_path)
+    assert second.read(SENDER, ENDPOINT, sent[-1], hold=True) is not None  # number 17
+    (mapped,) = second._maps.values()
+    assert mapped.entry == taken
+    assert taken in writer._credit  # (spent: below nothing)
+    writer.make_room()  # sees the page changed
+    assert taken not in writer._credit
+    assert taken not in writer._excused
+    writer.budget_ns, writer.max_wait_ns = LONG_NS, 1_000_000
+    for number in range(18, 34):  # 33 would push the new reader into dropping
+        put(number)
+    assert (writer.excused, writer.waited_out) == (1, 1)  # waited for, not excused

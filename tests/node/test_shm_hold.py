@@ -6,6 +6,8 @@ destroyed; a best-effort subscription never holds, and a best-effort publisher n
 
 from __future__ import annotations
 
+import sys
+
 from rosl.bus.header import topic_hash
 from tests.conftest import wait_until
 from tests.node.helpers import spin_until
@@ -31,6 +33,24 @@ def test_a_reliable_subscription_holds_its_topic_until_it_is_destroyed(ros):
 
     node.destroy_subscription(sub)
     assert held not in reader.held
+
+
+def test_topic_echo_never_holds_the_publisher_it_shows(ros, spawn):
+    from std_msgs.msg import UInt8MultiArray
+
+    node = ros.Node("hold_echoed")
+    pub = node.create_publisher(UInt8MultiArray, "echoed", 10)  # reliable: echo matches it
+    echo = spawn.command(
+        [sys.executable, "-m", "rosl", "topic", "echo", "/echoed", "--field", "layout.data_offset"]
+    )
+    message = UInt8MultiArray(data=bytes(40_000))
+    assert spin_until(
+        node, lambda: echo.count("^0$") > 0, 30.0, each=lambda: pub.publish(message)
+    ), echo.text
+    assert pub._writer.shm_sent > 0, "the messages did not take shared memory"
+    rings = list(pub._writer.shm._rings.values())
+    assert rings
+    assert [ring._holders() for ring in rings] == [[]] * len(rings)
 
 
 def test_best_effort_subscriptions_never_hold_and_best_effort_publishers_never_wait(ros):
