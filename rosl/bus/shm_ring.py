@@ -216,7 +216,7 @@ class RingWriter:
             return
         entries = self._entries
         if entries[0] != self._changes:  # a reader came or went
-            self._held = self._holders()
+            self._holders()
         if self._held:
             need = self._next - self.slots + self._margin  # a reader's cursor must be this far
             excused = self._excused
@@ -244,7 +244,7 @@ class RingWriter:
         return DESCRIPTOR.pack(self._pid, self.incarnation, number, size)
 
     def _holders(self) -> list[int]:
-        """Where the entries of reliable readers are (their first word's index)."""
+        """Look again where the entries of reliable readers are (their first words' indexes)."""
         entries = self._entries
         self._changes = entries[0]
         held = [
@@ -258,6 +258,7 @@ class RingWriter:
                 self._credit.pop(index, None)
                 self._excused.discard(index)
         self._tokens = tokens
+        self._held = held
         return held
 
     def _wait(self, need: int) -> None:
@@ -278,11 +279,11 @@ class RingWriter:
         behind: list[int] = []
         while not self.closed:
             now = clock()
+            overdrawn: list[int] = []
             if behind:  # the pause just slept was for these readers
                 spent = now - last
                 self.waited_ns += spent
-                for index in behind:
-                    self._charge(index, now, spent)
+                overdrawn = [index for index in behind if self._charge(index, now, spent)]
             last = now
             behind = [
                 index
@@ -292,6 +293,11 @@ class RingWriter:
                 and entries[index + 1] < need
                 and now - entries[index + 2] < hold_ns
             ]
+            for index in overdrawn:
+                if index in behind:  # (one that caught up meanwhile lost nothing: not excused)
+                    excused.add(index)
+                    self.excused += 1
+                    behind.remove(index)
             if not behind:
                 return
             if now >= deadline:
@@ -301,8 +307,8 @@ class RingWriter:
             time.sleep(PAUSES[min(step, len(PAUSES) - 1)])
             step += 1
 
-    def _charge(self, index: int, now: int, spent: int) -> None:
-        """Count ``spent`` ns of waiting against a reader; excuse it once it is past its budget.
+    def _charge(self, index: int, now: int, spent: int) -> bool:
+        """Count ``spent`` ns of waiting against a reader: whether it is past its budget.
 
         Each reader's credit fills at ``budget_ns`` per :data:`WINDOW_NS`, up to
         ``budget_ns``: any stretch of time costs the writer at most that much and a quarter.
@@ -315,9 +321,7 @@ class RingWriter:
             credit[0] = min(budget, credit[0] + (now - credit[1]) * budget // WINDOW_NS)
             credit[1] = now
         credit[0] -= spent
-        if credit[0] < 0:
-            self._excused.add(index)
-            self.excused += 1
+        return credit[0] < 0
 
     @property
     def written(self) -> int:

@@ -272,7 +272,9 @@ def echo(
         msg_type, topic, lambda m, info: inbox.append((m, info)), qos, raw=options.raw
     )
     subscription.log_loss = False  # echo says "A message was lost!!!" itself, as ros2 does
-    subscription.log_mismatch = False  # (a publisher of another type: refused below, one line)
+    # a publisher of another type: refused below in one line, or else warned of (once the
+    # graph names it: it may have been heard before discovery told of it)
+    subscription.log_mismatch = False
     subscription.holding = False  # a view never slows what it shows (see rosl.bus.shm_ring)
     node.participant.rehold()
     import rosl
@@ -285,6 +287,9 @@ def echo(
     while rosl.ok():
         if type_name and not shown:  # a publisher that appears while we wait may not match
             check_published_type(node.participant.graph, topic, resolved)
+        stranger = subscription.mismatched_from
+        if stranger is not None and subscription.warn_mismatch(*stranger):
+            subscription.mismatched_from = None
         executor.spin_once(timeout_sec=0.1)
         lost = subscription.lost
         if lost > lost_seen and options.lost_messages:

@@ -300,10 +300,12 @@ def subscribe_drawable(
         best_effort = str(endpoint.qos.get("reliability", "")).upper() == "BEST_EFFORT"
         reliability = ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE
         qos = QoSProfile(depth=depth, durability=durability, reliability=reliability)
-        node.create_subscription(
+        subscription = node.create_subscription(
             get_message_class(endpoint.type), endpoint.name, callback(endpoint.name, endpoint.type),
             qos,
         )  # fmt: skip
+        subscription.holding = False  # a view never slows what it shows (see rosl.bus.shm_ring)
+        node.participant.rehold()
 
 
 def _footprint(urdf: str) -> Any:

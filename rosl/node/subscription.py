@@ -118,7 +118,9 @@ class Subscription(Queued):
         self._streams = participant.reader.streams  # sequence bookkeeping per publisher
         self._lost_told = 0  # the loss already reported in the log
         self.log_loss = True  # False for tools that report loss in their own words (echo)
-        self.log_mismatch = True  # False for tools that refuse another type themselves (echo)
+        # False for tools that refuse another type themselves (echo): they call warn_mismatch
+        self.log_mismatch = True
+        self.mismatched_from: tuple[int, int] | None = None  # the last such publisher
         self._lost_told_at = 0  # its receive time (ns)
         self._replayed: deque[tuple[int, int, int]] = deque(maxlen=4096)
         self._depth = queue_depth(qos)
@@ -323,19 +325,27 @@ class Subscription(Queued):
 
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1
-        if (
-            not self.log_mismatch
-            or delivery.sender in self._warned
-            or len(self._warned) >= MAX_PEERS
-        ):
-            return
-        self._warned.add(delivery.sender)
-        found = self._graph.sender(delivery.sender, delivery.endpoint, PUBLISHER, self.topic)
+        self.mismatched_from = (delivery.sender, delivery.endpoint)
+        if self.log_mismatch:
+            self.warn_mismatch(delivery.sender, delivery.endpoint, named=False)
+
+    def warn_mismatch(self, sender: int, endpoint: int, named: bool = True) -> bool:
+        """Warn (once per process) of a publisher whose messages are of another type.
+
+        With ``named``, only once the graph names the publisher (False: not yet, ask again).
+        """
+        if sender in self._warned or len(self._warned) >= MAX_PEERS:
+            return True
+        found = self._graph.sender(sender, endpoint, PUBLISHER, self.topic)
+        if named and not found:
+            return False
+        self._warned.add(sender)
         who = f" from {found[0].fqn} ({found[1].type})" if found else ""
         self.node.get_logger().warn(
             f"subscription on {self.topic} expects {self.type_name} but got a message of another "
             f"type{who}; dropped without decoding (publisher and subscriber types must match)"
         )
+        return True
 
     def _tell_loss(self, delivery: Delivery) -> None:
         """Log messages lost on this topic since the last report (at most every few seconds)."""

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import re
+import signal
+import time
 from typing import TYPE_CHECKING
 
 import pytest
 
 from rosl.graph.records import PUBLISHER, SUBSCRIPTION
 from tests.cli.conftest import Result, assert_user_error, run, timed, wait_graph
+from tests.conftest import ChildOutput
 from tests.graph.support import Watched
 
 if TYPE_CHECKING:
@@ -231,6 +234,28 @@ def test_echo_with_a_type_other_than_the_publishers_fails_at_once(system, proces
         "tutorial_pkg/msg/MyData"
     )
     assert took < 20.0  # refused from the graph, did not wait on for messages
+
+
+def test_echo_of_a_topic_of_two_types_warns_once_of_the_other_publisher(processes) -> None:
+    # a String and an Int32 publisher on /mix: echo as String shows the strings and names
+    # the other publisher once (rclpy warns of an incompatible type too)
+    for name, module, type_name in (("strings", "std_msgs.msg", "String"),
+                                    ("numbers", "std_msgs.msg", "Int32")):  # fmt: skip
+        processes.python(PUBLISHER_OF, name, "/mix", module, type_name)
+    wait_graph(lambda g: g.count(PUBLISHER, "/mix") == 2)
+    echo = ChildOutput(processes.rosl("topic", "echo", "/mix", "std_msgs/msg/String"))
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline and not (
+        "another type" in echo.text["err"] and echo.text["out"].count("data: ''") >= 40
+    ):
+        echo._read(0.05)
+    echo.popen.send_signal(signal.SIGINT)
+    echo.popen.wait(30.0)
+    echo.pump()
+    assert echo.text["out"].count("data: ''") >= 40, echo.text
+    warnings = [line for line in echo.text["err"].splitlines() if "another type" in line]
+    assert len(warnings) == 1, echo.text["err"]
+    assert "from /numbers (std_msgs/msg/Int32)" in warnings[0]
 
 
 def test_echo_of_an_unknown_topic_warns_and_names_the_closest(system, processes) -> None:
