@@ -350,6 +350,7 @@ if __name__ == '__main__':
 
 QUEUE_SERVER = """
 import collections
+import sys
 import threading
 import time
 
@@ -360,6 +361,10 @@ from rclpy.executors import MultiThreadedExecutor
 from rclpy.node import Node
 
 from example_interfaces.action import Fibonacci
+
+
+def say(text):  # one write: two threads' lines never interleave (print writes twice)
+    sys.stdout.write(text + '\\n')
 
 
 class QueueServer(Node):
@@ -376,20 +381,20 @@ class QueueServer(Node):
             handle_accepted_callback=self.handle_accepted_callback,
             execute_callback=self.execute_callback,
             callback_group=ReentrantCallbackGroup())
-        print('ready', flush=True)
+        say('ready')
 
     def handle_accepted_callback(self, goal_handle):
         with self._goal_queue_lock:
             if self._current_goal is not None:
                 self._goal_queue.append(goal_handle)
-                print(f'queued order {goal_handle.request.order}', flush=True)
+                say(f'queued order {goal_handle.request.order}')
             else:
                 self._current_goal = goal_handle
                 self._current_goal.execute()
 
     def execute_callback(self, goal_handle):
         try:
-            print(f'executing order {goal_handle.request.order}', flush=True)
+            say(f'executing order {goal_handle.request.order}')
             if self._first:  # (the test's second goal comes while this one runs, however slow)
                 self._first = False
                 deadline = time.monotonic() + 60.0
