@@ -37,9 +37,9 @@ crash, an exit) costs it at most :data:`HOLD_NS` once. Each reader has a credit 
 :data:`BUDGET_NS`, refilled at that much per :data:`WINDOW_NS`: one that spends it is
 steadily slower than the writer (a keep-last subscriber whose callbacks cannot keep up), not
 behind by a burst, and is not waited for until it has caught up; so it costs the publisher a
-quarter of its time, and a credit, at most, but never sets its pace (Fast DDS's data
-sharing, which waits for every reader, would). Best-effort publishers and
-subscribers never wait and never hold.
+quarter of its time, and a credit, at most, and sets its pace only if it is at most a third
+slower (Fast DDS's data sharing, which waits for every reader, lets any reader set it).
+Best-effort publishers and subscribers never wait and never hold.
 
 Zero-copy: a view into a slot would be safe only until the slot is reused, which a reader
 cannot prevent; so every read makes exactly one copy and the sequence check runs after that
