@@ -257,7 +257,7 @@ def echo(
 
     parts = field_parts(options.field)
     node = session.node()  # first: its participant then answers the graph query too
-    if type_name is None and topic not in session.graph().topics():
+    if type_name is None and topic not in session.graph_knowing(topic).topics():
         yield unpublished_warning(topic)  # then ros2's error, from resolve_type
     resolved = resolve_type(session, topic, type_name)
     msg_type = get_message_class(resolved)

@@ -22,6 +22,10 @@ if TYPE_CHECKING:
     from rosl.node.participant import Participant
 
 QUERY_TIMEOUT = 1.0
+# a topic the graph does not know after its query is waited for this much longer, before a
+# command fails on it: a process of a loaded machine may answer after the query looked
+# complete (nobody had answered within its quiet time)
+LATE_S = 1.0
 
 
 class Session:
@@ -60,6 +64,13 @@ class Session:
             discovery.wait_complete(qid, timeout=QUERY_TIMEOUT)
             self._completed = True
         return self.participant.graph
+
+    def graph_knowing(self, topic: str) -> GraphCache:
+        """The graph, once it knows ``topic`` or :data:`LATE_S` after its query."""
+        graph = self.graph()
+        if topic not in graph.topics():
+            graph.wait_for(lambda: topic in graph.topics(), LATE_S)
+        return graph
 
     def node(self) -> Node:
         """The command's hidden node (created on first use, on this session's domain)."""

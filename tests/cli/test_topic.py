@@ -258,6 +258,25 @@ def test_echo_of_a_topic_of_two_types_warns_once_of_the_other_publisher(processe
     assert "from /numbers (std_msgs/msg/Int32)" in warnings[0]
 
 
+def test_echo_waits_a_little_for_a_publisher_that_answers_late(processes) -> None:
+    # the talker is stopped while echo asks who is there, so the query looks complete with
+    # nobody in it; it goes on 0.6 s after echo started: echo still finds the topic
+    talker = ChildOutput(
+        processes.python(PUBLISHER_OF, "late_talker", "/late", "std_msgs.msg", "String")
+    )
+    deadline = time.monotonic() + 30.0
+    while "ready" not in talker.text["out"] and time.monotonic() < deadline:
+        talker._read(0.05)
+    talker.popen.send_signal(signal.SIGSTOP)
+    try:
+        echo = processes.rosl("topic", "echo", "/late", "--once", env={"NO_COLOR": "1"})
+        time.sleep(0.6)
+    finally:
+        talker.popen.send_signal(signal.SIGCONT)
+    out, err = echo.communicate(timeout=30.0)
+    assert (echo.returncode, out, err) == (0, "data: ''\n---\n", "")
+
+
 def test_echo_of_an_unknown_topic_warns_and_names_the_closest(system, processes) -> None:
     result = run(processes, "topic", "echo", "/my_dat")
     assert result.out == "WARNING: topic [/my_dat] does not appear to be published yet\n"
