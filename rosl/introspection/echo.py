@@ -275,8 +275,7 @@ def echo(
     # a publisher of another type: refused below in one line, or else warned of (once the
     # graph names it: it may have been heard before discovery told of it)
     subscription.log_mismatch = False
-    subscription.holding = False  # a view never slows what it shows (see rosl.bus.shm_ring)
-    node.participant.rehold()
+    subscription.never_hold()  # a view never slows what it shows (see rosl.bus.shm_ring)
     import rosl
 
     executor = rosl.SingleThreadedExecutor()

@@ -304,8 +304,7 @@ def subscribe_drawable(
             get_message_class(endpoint.type), endpoint.name, callback(endpoint.name, endpoint.type),
             qos,
         )  # fmt: skip
-        subscription.holding = False  # a view never slows what it shows (see rosl.bus.shm_ring)
-        node.participant.rehold()
+        subscription.never_hold()  # a view never slows what it shows (see rosl.bus.shm_ring)
 
 
 def _footprint(urdf: str) -> Any:

@@ -323,6 +323,11 @@ class Subscription(Queued):
         self._decode = self._store.decoder(self.type_name)
         return self._decode(payload)
 
+    def never_hold(self) -> None:
+        """Never keep a shared-memory publisher waiting (a tool that views what it takes)."""
+        self.holding = False
+        self.node.participant.rehold()
+
     def _mismatch(self, delivery: Delivery) -> None:
         self.mismatched += 1
         self.mismatched_from = (delivery.sender, delivery.endpoint)
